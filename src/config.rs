@@ -1,0 +1,536 @@
+//! Options in two stages (as ripgrep does): raw options as the user wrote them (command
+//! line or TOML, every field optional), then a resolved [`Job`] with units converted to
+//! millimetres, defaults filled in and every value checked. The command line wins over
+//! the configuration file.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{Error, Result};
+
+/// Millimetres per inch.
+pub const MM_PER_INCH: f64 = 25.4;
+
+/// A unit of length.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LengthUnit {
+    /// Millimetres.
+    Mm,
+    /// Centimetres.
+    Cm,
+    /// Metres.
+    M,
+    /// Inches.
+    In,
+    /// Feet.
+    Ft,
+}
+
+impl LengthUnit {
+    /// Millimetres in one unit.
+    pub fn mm(self) -> f64 {
+        match self {
+            LengthUnit::Mm => 1.0,
+            LengthUnit::Cm => 10.0,
+            LengthUnit::M => 1000.0,
+            LengthUnit::In => MM_PER_INCH,
+            LengthUnit::Ft => 12.0 * MM_PER_INCH,
+        }
+    }
+
+    fn parse_suffix(s: &str) -> Option<LengthUnit> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "mm" => Some(LengthUnit::Mm),
+            "cm" => Some(LengthUnit::Cm),
+            "m" => Some(LengthUnit::M),
+            "in" | "inch" | "inches" | "\"" => Some(LengthUnit::In),
+            "ft" | "foot" | "feet" | "'" => Some(LengthUnit::Ft),
+            _ => None,
+        }
+    }
+}
+
+/// Splits "4.5ft" into (4.5, "ft").
+fn split_number(s: &str) -> (&str, &str) {
+    let s = s.trim();
+    let end = s
+        .char_indices()
+        .find(|&(_, c)| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+' || c == 'e'))
+        .map_or(s.len(), |(i, _)| i);
+    // "1e" would swallow the 'e' of nothing; numbers here never need exponents
+    // followed by a unit starting with 'e', so trim a trailing 'e'.
+    let end = if s[..end].ends_with('e') {
+        end - 1
+    } else {
+        end
+    };
+    (&s[..end], &s[end..])
+}
+
+/// Parses a length with its unit ("4ft", "1.2m", "48in", "0.25 in", "600mm") into
+/// millimetres. A unit is required: a bare "4" could mean feet or millimetres.
+pub fn parse_length(text: &str) -> std::result::Result<f64, String> {
+    let (number, unit) = split_number(text);
+    let value: f64 = number.parse().map_err(|_| {
+        format!(
+            "'{text}' is not a length; write a number and a unit, like 4ft, 1.2m, 48in or 600mm"
+        )
+    })?;
+    if unit.trim().is_empty() {
+        return Err(format!(
+            "'{text}' has no unit; write it with one, like {text}mm, {text}in or {text}ft"
+        ));
+    }
+    let unit = LengthUnit::parse_suffix(unit).ok_or_else(|| {
+        format!(
+            "'{text}' has an unknown unit '{}'; use mm, cm, m, in or ft",
+            unit.trim()
+        )
+    })?;
+    if !value.is_finite() {
+        return Err(format!("'{text}' is not a finite length"));
+    }
+    Ok(value * unit.mm())
+}
+
+/// A sheet of material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SheetSize {
+    /// Width in mm.
+    pub width: f64,
+    /// Height in mm.
+    pub height: f64,
+    /// As the user wrote it ("18x24in", "A2").
+    pub name: String,
+}
+
+/// Parses a sheet size: `WxH` with a unit (`18x24in`, `600x400mm`, `18in x 24in`), or
+/// a name: `A0`..`A5` (portrait, ISO 216), `letter` (8.5×11 in), `legal` (8.5×14 in),
+/// `tabloid` (11×17 in).
+pub fn parse_sheet(text: &str) -> std::result::Result<SheetSize, String> {
+    let named = match text.trim().to_ascii_lowercase().as_str() {
+        "a0" => Some((841.0, 1189.0)),
+        "a1" => Some((594.0, 841.0)),
+        "a2" => Some((420.0, 594.0)),
+        "a3" => Some((297.0, 420.0)),
+        "a4" => Some((210.0, 297.0)),
+        "a5" => Some((148.0, 210.0)),
+        "letter" => Some((8.5 * MM_PER_INCH, 11.0 * MM_PER_INCH)),
+        "legal" => Some((8.5 * MM_PER_INCH, 14.0 * MM_PER_INCH)),
+        "tabloid" => Some((11.0 * MM_PER_INCH, 17.0 * MM_PER_INCH)),
+        _ => None,
+    };
+    let (width, height) = match named {
+        Some(size) => size,
+        None => {
+            let bad = || {
+                format!(
+                    "'{text}' is not a sheet size; write WxH with a unit (18x24in, 600x400mm) or a name (A0..A5, letter, legal, tabloid)"
+                )
+            };
+            let lower = text.to_ascii_lowercase();
+            let (w, h) = lower.split_once('x').ok_or_else(bad)?;
+            let (h_number, h_unit) = split_number(h);
+            if h_number.is_empty() {
+                return Err(bad());
+            }
+            // "18x24in": the unit after the height serves both; "18in x 24in" also works.
+            let (w_number, w_unit) = split_number(w);
+            let w_text = if w_unit.trim().is_empty() {
+                format!("{w_number}{h_unit}")
+            } else {
+                w.to_string()
+            };
+            let width = parse_length(&w_text).map_err(|_| bad())?;
+            let height = parse_length(h).map_err(|_| bad())?;
+            (width, height)
+        }
+    };
+    if width <= 0.0 || height <= 0.0 {
+        return Err(format!(
+            "sheet '{text}' must have a positive width and height"
+        ));
+    }
+    Ok(SheetSize {
+        width,
+        height,
+        name: text.trim().to_string(),
+    })
+}
+
+/// The panel schemes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum SchemeName {
+    /// One panel per face, tabs on interior edges.
+    HalfEdge,
+    /// One panel per edge: Bézier edge bands with flaps, joined at face corners.
+    QuadEdge,
+    /// Quad-edge panels with wings along the neighbouring face edges.
+    WingedEdge,
+    /// Plain-weaving ribbons from the extended graph rotation system.
+    Woven,
+}
+
+impl fmt::Display for SchemeName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SchemeName::HalfEdge => "half-edge",
+            SchemeName::QuadEdge => "quad-edge",
+            SchemeName::WingedEdge => "winged-edge",
+            SchemeName::Woven => "woven",
+        })
+    }
+}
+
+/// Options that describe the model and its physical size (shared by `inspect` and the
+/// main command). Every field is optional so that the command line and the TOML file
+/// can be merged; [`ModelOptions::resolve`] fills in the defaults.
+#[derive(Clone, Debug, Default, Deserialize, clap::Args)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct ModelOptions {
+    /// Longest side of the model's bounding box when built, with a unit: 4ft, 1.2m,
+    /// 48in, 600mm. Overrides --units. [default: the model's own size in --units]
+    #[arg(long, value_name = "LENGTH")]
+    pub size: Option<String>,
+
+    /// What one model unit is, when --size is not given. [default: mm]
+    #[arg(long, value_name = "UNIT")]
+    pub units: Option<LengthUnit>,
+
+    /// Extra factor applied after --size or --units. [default: 1]
+    #[arg(long, value_name = "K")]
+    pub scale: Option<f64>,
+
+    /// Merge vertices that share a position where the mesh stays manifold (OBJ and OFF
+    /// keep them apart by default; STL is always welded). [default: off]
+    #[arg(long)]
+    #[serde(default)]
+    pub weld: bool,
+
+    /// Faces whose planarity error (largest corner distance from the best-fit plane,
+    /// divided by the face's diameter) exceeds this are non-planar. [default: 0.001]
+    #[arg(long, value_name = "FRACTION")]
+    pub planarity_tol: Option<f64>,
+}
+
+/// How model units become millimetres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scaling {
+    /// `Some(mm)`: the longest bounding-box side becomes this many millimetres.
+    pub size: Option<f64>,
+    /// Millimetres per model unit when `size` is not given.
+    pub unit_mm: f64,
+    /// Extra factor.
+    pub scale: f64,
+}
+
+impl Scaling {
+    /// Millimetres per model unit for a model whose longest bounding-box side is
+    /// `longest_side` model units.
+    pub fn mm_per_unit(&self, longest_side: f64) -> f64 {
+        let base = match self.size {
+            Some(mm) if longest_side > 0.0 => mm / longest_side,
+            _ => self.unit_mm,
+        };
+        base * self.scale
+    }
+}
+
+/// Resolved model options.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelSettings {
+    /// Physical scaling.
+    pub scaling: Scaling,
+    /// Weld coincident vertices where manifold.
+    pub weld: bool,
+    /// Planarity tolerance (fraction of face diameter).
+    pub planarity_tol: f64,
+}
+
+impl ModelOptions {
+    /// Fills fields missing here from `other` (the configuration file).
+    pub fn or(self, other: ModelOptions) -> ModelOptions {
+        ModelOptions {
+            size: self.size.or(other.size),
+            units: self.units.or(other.units),
+            scale: self.scale.or(other.scale),
+            weld: self.weld || other.weld,
+            planarity_tol: self.planarity_tol.or(other.planarity_tol),
+        }
+    }
+
+    /// Checks every value and fills in defaults.
+    pub fn resolve(&self) -> Result<ModelSettings> {
+        let size = match &self.size {
+            Some(text) => {
+                let mm = parse_length(text).map_err(|e| Error::Usage(format!("--size: {e}")))?;
+                if mm <= 0.0 {
+                    return Err(Error::Usage(format!("--size: '{text}' must be positive")));
+                }
+                Some(mm)
+            }
+            None => None,
+        };
+        let scale = self.scale.unwrap_or(1.0);
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(Error::Usage(format!(
+                "--scale: {scale} must be a positive number"
+            )));
+        }
+        let planarity_tol = self.planarity_tol.unwrap_or(1e-3);
+        if !(planarity_tol.is_finite() && planarity_tol > 0.0 && planarity_tol < 1.0) {
+            return Err(Error::Usage(format!(
+                "--planarity-tol: {planarity_tol} must be between 0 and 1 (a fraction of the face size)"
+            )));
+        }
+        Ok(ModelSettings {
+            scaling: Scaling {
+                size,
+                unit_mm: self.units.unwrap_or(LengthUnit::Mm).mm(),
+                scale,
+            },
+            weld: self.weld,
+            planarity_tol,
+        })
+    }
+}
+
+/// Options of the main command (building sheets). Like [`ModelOptions`], all optional.
+#[derive(Clone, Debug, Default, Deserialize, clap::Args)]
+#[serde(deny_unknown_fields, rename_all = "kebab-case")]
+pub struct BuildOptions {
+    /// Panel scheme. [default: quad-edge]
+    #[arg(long, value_name = "SCHEME")]
+    pub scheme: Option<SchemeName>,
+
+    /// Sheet size: WxH with a unit (18x24in, 600x400mm) or a name (A0..A5, letter,
+    /// legal, tabloid). [default: 18x24in]
+    #[arg(long, value_name = "SIZE")]
+    pub sheet: Option<String>,
+
+    /// Empty border kept on every sheet edge, with a unit. [default: 0.25in]
+    #[arg(long, value_name = "LENGTH")]
+    pub margin: Option<String>,
+
+    /// Smallest gap between two parts on a sheet, with a unit. [default: 0.125in]
+    #[arg(long, value_name = "LENGTH")]
+    pub spacing: Option<String>,
+
+    /// Output folder (created; replaced atomically). [default: ./NAME, NAME being the
+    /// model's file name without extension]
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+
+    /// Output formats, comma separated: svg, dxf. [default: svg]
+    #[arg(long, value_name = "LIST")]
+    pub format: Option<String>,
+
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub model: ModelOptions,
+}
+
+/// Which files to write.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OutputFormats {
+    /// One SVG per sheet.
+    pub svg: bool,
+    /// One R12 DXF per sheet.
+    pub dxf: bool,
+}
+
+/// A fully resolved build job: every length in millimetres.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Job {
+    /// The model file.
+    pub model_path: PathBuf,
+    /// Model options.
+    pub model: ModelSettings,
+    /// Panel scheme.
+    pub scheme: SchemeName,
+    /// Sheet size.
+    pub sheet: SheetSize,
+    /// Sheet margin, mm.
+    pub margin: f64,
+    /// Part spacing, mm.
+    pub spacing: f64,
+    /// Output folder.
+    pub out: PathBuf,
+    /// File formats.
+    pub formats: OutputFormats,
+}
+
+impl BuildOptions {
+    /// Fills fields missing here from `other` (the configuration file).
+    pub fn or(self, other: BuildOptions) -> BuildOptions {
+        BuildOptions {
+            scheme: self.scheme.or(other.scheme),
+            sheet: self.sheet.or(other.sheet),
+            margin: self.margin.or(other.margin),
+            spacing: self.spacing.or(other.spacing),
+            out: self.out.or(other.out),
+            format: self.format.or(other.format),
+            model: self.model.or(other.model),
+        }
+    }
+
+    /// Checks every value, converts units and fills in defaults.
+    pub fn resolve(&self, model_path: &Path) -> Result<Job> {
+        let usage = |option: &str, e: String| Error::Usage(format!("--{option}: {e}"));
+        let sheet = parse_sheet(self.sheet.as_deref().unwrap_or("18x24in"))
+            .map_err(|e| usage("sheet", e))?;
+        let margin = parse_length(self.margin.as_deref().unwrap_or("0.25in"))
+            .map_err(|e| usage("margin", e))?;
+        let spacing = parse_length(self.spacing.as_deref().unwrap_or("0.125in"))
+            .map_err(|e| usage("spacing", e))?;
+        if margin < 0.0 || spacing < 0.0 {
+            return Err(Error::Usage(
+                "--margin and --spacing cannot be negative".to_string(),
+            ));
+        }
+        if 2.0 * margin >= sheet.width.min(sheet.height) {
+            return Err(Error::Usage(format!(
+                "--margin {} leaves no room on a {} sheet ({:.1} x {:.1} mm)",
+                self.margin.as_deref().unwrap_or("0.25in"),
+                sheet.name,
+                sheet.width,
+                sheet.height
+            )));
+        }
+        let formats = parse_formats(self.format.as_deref().unwrap_or("svg"))
+            .map_err(|e| usage("format", e))?;
+        let out = match &self.out {
+            Some(dir) => dir.clone(),
+            None => PathBuf::from(
+                model_path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "unfold-out".to_string()),
+            ),
+        };
+        Ok(Job {
+            model_path: model_path.to_path_buf(),
+            model: self.model.resolve()?,
+            scheme: self.scheme.unwrap_or(SchemeName::QuadEdge),
+            sheet,
+            margin,
+            spacing,
+            out,
+            formats,
+        })
+    }
+}
+
+fn parse_formats(text: &str) -> std::result::Result<OutputFormats, String> {
+    let mut formats = OutputFormats {
+        svg: false,
+        dxf: false,
+    };
+    for part in text.split(',') {
+        match part.trim().to_ascii_lowercase().as_str() {
+            "svg" => formats.svg = true,
+            "dxf" => formats.dxf = true,
+            other => return Err(format!("unknown format '{other}'; use svg, dxf or svg,dxf")),
+        }
+    }
+    Ok(formats)
+}
+
+/// Reads a TOML configuration file. Keys are the long option names (`sheet`,
+/// `size`, `planarity-tol`, …); unknown keys are usage errors naming the key.
+pub fn load_config<T: for<'de> Deserialize<'de>>(path: &Path) -> Result<T> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Usage(format!("--config {}: cannot read it: {e}", path.display())))?;
+    toml::from_str(&text).map_err(|e| {
+        Error::Usage(format!(
+            "--config {}: {}",
+            path.display(),
+            e.to_string().trim().replace('\n', " ")
+        ))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9 * b.abs().max(1.0)
+    }
+
+    #[test]
+    fn lengths_in_every_unit() {
+        for (text, mm) in [
+            ("4ft", 1219.2),
+            ("1.2m", 1200.0),
+            ("48in", 1219.2),
+            ("0.25 in", 6.35),
+            ("600mm", 600.0),
+            ("12.5cm", 125.0),
+            ("1e3mm", 1000.0),
+        ] {
+            assert!(close(parse_length(text).unwrap(), mm), "{text}");
+        }
+        assert!(parse_length("4").unwrap_err().contains("no unit"));
+        assert!(parse_length("4yd").unwrap_err().contains("unknown unit"));
+        assert!(parse_length("ft").is_err());
+    }
+
+    #[test]
+    fn sheet_sizes() {
+        let s = parse_sheet("18x24in").unwrap();
+        assert!((s.width - 457.2).abs() < 1e-9 && (s.height - 609.6).abs() < 1e-9);
+        let s = parse_sheet("600x400mm").unwrap();
+        assert_eq!((s.width, s.height), (600.0, 400.0));
+        let s = parse_sheet("18in x 24in").unwrap();
+        assert!((s.height - 609.6).abs() < 1e-9);
+        assert_eq!(parse_sheet("A0").unwrap().width, 841.0);
+        assert_eq!(parse_sheet("a4").unwrap().height, 297.0);
+        assert!((parse_sheet("letter").unwrap().width - 215.9).abs() < 1e-9);
+        assert!((parse_sheet("tabloid").unwrap().height - 431.8).abs() < 1e-9);
+        assert!(parse_sheet("18x24").is_err());
+        assert!(parse_sheet("0x24in").is_err());
+        assert!(parse_sheet("huge").is_err());
+    }
+
+    #[test]
+    fn command_line_wins_over_config() {
+        let cli = BuildOptions {
+            sheet: Some("A2".into()),
+            ..Default::default()
+        };
+        let file: BuildOptions =
+            toml::from_str("sheet = \"18x24in\"\nscheme = \"woven\"\nsize = \"4ft\"\n").unwrap();
+        let job = cli.or(file).resolve(Path::new("bunny.obj")).unwrap();
+        assert_eq!(job.sheet.name, "A2");
+        assert_eq!(job.scheme, SchemeName::Woven);
+        assert!(close(job.model.scaling.size.unwrap(), 1219.2));
+        assert_eq!(job.out, PathBuf::from("bunny"));
+    }
+
+    #[test]
+    fn unknown_config_key_is_rejected() {
+        let e = toml::from_str::<BuildOptions>("sheeet = \"A2\"").unwrap_err();
+        assert!(e.to_string().contains("sheeet"));
+    }
+
+    #[test]
+    fn scaling_by_size_and_units() {
+        let by_size = Scaling {
+            size: Some(1219.2),
+            unit_mm: 1.0,
+            scale: 1.0,
+        };
+        assert!((by_size.mm_per_unit(2.0) - 609.6).abs() < 1e-9);
+        let by_units = Scaling {
+            size: None,
+            unit_mm: LengthUnit::Cm.mm(),
+            scale: 2.0,
+        };
+        assert_eq!(by_units.mm_per_unit(123.0), 20.0);
+    }
+}

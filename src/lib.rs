@@ -1,0 +1,250 @@
+//! `unfold` turns a 3D polygon mesh into developable flat panels for laser cutting.
+//!
+//! The pipeline is a chain of plain functions over plain data:
+//!
+//! ```text
+//! read (OBJ, OFF, STL) -> prepare (validate, weld, orient) -> half-edge mesh
+//!   -> scheme -> 3D panels -> flatten -> nest -> export
+//! ```
+//!
+//! This crate is the library; the `unfold` binary only parses options and calls it.
+//! What exists so far: reading, preparation, the half-edge core and `inspect`.
+
+pub mod config;
+pub mod error;
+pub mod mesh;
+
+use std::path::Path;
+
+use serde::Serialize;
+
+pub use config::{BuildOptions, Job, ModelOptions, ModelSettings};
+pub use error::{Error, InputError, Result};
+
+use mesh::read::Group;
+use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};
+
+/// Reads and prepares a model: the first two stages of every job.
+pub fn load_model(
+    path: &Path,
+    settings: &ModelSettings,
+) -> Result<(mesh::RawModel, PreparedModel)> {
+    let raw = mesh::read_model(path)?;
+    let prepared = mesh::prepare(
+        &raw,
+        &PrepareOptions {
+            weld: settings.weld,
+        },
+    )?;
+    Ok((raw, prepared))
+}
+
+/// The physical size a model will be built at.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PhysicalSize {
+    /// Millimetres per model unit.
+    pub mm_per_unit: f64,
+    /// Bounding-box sides in mm.
+    pub size_mm: [f64; 3],
+    /// Surface area in mm².
+    pub surface_area_mm2: f64,
+}
+
+/// What `unfold inspect` reports about a model.
+#[derive(Clone, Debug, Serialize)]
+pub struct Inspection {
+    /// The model file as given on the command line.
+    pub path: String,
+    /// Its format.
+    pub format: mesh::Format,
+    /// Facts of the file as it is (no repair).
+    pub input: SoupFacts,
+    /// Facts of the welded soup, with `--weld`.
+    pub welded: Option<SoupFacts>,
+    /// Facts of the prepared half-edge mesh.
+    pub mesh: Topology,
+    /// Geometry in model units.
+    pub geometry: GeometryFacts,
+    /// Size when built.
+    pub physical: PhysicalSize,
+    /// Named groups (OBJ `o`/`g`).
+    pub groups: Vec<Group>,
+    /// Statements read but not used, with counts.
+    pub ignored: Vec<(String, usize)>,
+    /// Repairs and observations.
+    pub notes: Vec<Note>,
+}
+
+/// Reads, checks and measures a model. Errors if it cannot be built at all.
+pub fn inspect(path: &Path, settings: &ModelSettings) -> Result<Inspection> {
+    let (raw, prepared) = load_model(path, settings)?;
+    let mesh = &prepared.mesh;
+    let geometry = mesh.geometry_facts(settings.planarity_tol);
+    let mm = settings.scaling.mm_per_unit(geometry.longest_side());
+    let size_mm = [0, 1, 2].map(|k| (geometry.bbox_max[k] - geometry.bbox_min[k]) * mm);
+    let mut notes = prepared.notes.clone();
+    if geometry.non_planar_faces > 0 {
+        notes.push(Note {
+            kind: "non-planar-faces",
+            message: format!(
+                "{} faces are not planar within {} of their size (worst: face {} at {:.2e}); they will be triangulated when panels are built",
+                geometry.non_planar_faces,
+                settings.planarity_tol,
+                geometry
+                    .least_planar_face
+                    .map(|f| mesh.face_source(mesh::FaceId(f)))
+                    .unwrap_or(0),
+                geometry.max_planarity_error
+            ),
+        });
+    }
+    Ok(Inspection {
+        path: path.display().to_string(),
+        format: raw.format,
+        input: prepared.input.clone(),
+        welded: prepared.welded.clone(),
+        mesh: mesh.topology(),
+        physical: PhysicalSize {
+            mm_per_unit: mm,
+            size_mm,
+            surface_area_mm2: geometry.surface_area * mm * mm,
+        },
+        geometry,
+        groups: raw.groups.clone(),
+        ignored: raw.ignored.clone(),
+        notes,
+    })
+}
+
+impl Inspection {
+    /// The human-readable report.
+    pub fn to_text(&self) -> String {
+        use std::fmt::Write;
+        let mut s = String::new();
+        let i = &self.input;
+        let m = &self.mesh;
+        let g = &self.geometry;
+        let _ = writeln!(s, "{} ({:?})", self.path, self.format);
+        let _ = writeln!(
+            s,
+            "input:       vertices {}  edges {}  faces {}  boundary edges {}  euler {}",
+            i.vertices, i.edges, i.faces, i.boundary_edges, i.euler_characteristic
+        );
+        if i.vertices_in_file != i.vertices {
+            let _ = writeln!(
+                s,
+                "             {} vertices in the file, {} used by no face",
+                i.vertices_in_file,
+                i.vertices_in_file - i.vertices
+            );
+        }
+        let _ = writeln!(
+            s,
+            "             non-manifold edges {}  bow-tie vertices {}  misoriented edges {}",
+            i.non_manifold_edges, i.non_manifold_vertices, i.misoriented_edges
+        );
+        if let Some(w) = &self.welded {
+            let _ = writeln!(
+                s,
+                "welded:      vertices {}  edges {}  faces {}  boundary edges {}  euler {}",
+                w.vertices, w.edges, w.faces, w.boundary_edges, w.euler_characteristic
+            );
+        }
+        let _ = writeln!(
+            s,
+            "mesh:        vertices {}  edges {}  faces {}  boundary edges {}  boundary loops {}",
+            m.vertices, m.edges, m.faces, m.boundary_edges, m.boundary_loops
+        );
+        let _ = writeln!(
+            s,
+            "topology:    genus {}  euler {}  components {}",
+            m.genus,
+            m.euler_characteristic,
+            m.components.len()
+        );
+        for (k, c) in m.components.iter().enumerate().take(10) {
+            let _ = writeln!(
+                s,
+                "             component {}: vertices {} edges {} faces {}, {}, genus {}",
+                k + 1,
+                c.vertices,
+                c.edges,
+                c.faces,
+                if c.closed {
+                    "closed".to_string()
+                } else {
+                    format!("{} boundary loops", c.boundary_loops)
+                },
+                c.genus
+            );
+        }
+        if m.components.len() > 10 {
+            let _ = writeln!(
+                s,
+                "             … and {} more components",
+                m.components.len() - 10
+            );
+        }
+        let sizes: Vec<String> = m
+            .face_sizes
+            .iter()
+            .map(|(n, count)| format!("{n}-gons {count}"))
+            .collect();
+        let _ = writeln!(s, "face sizes:  {}", sizes.join("  "));
+        let size = [0, 1, 2].map(|k| g.bbox_max[k] - g.bbox_min[k]);
+        let _ = writeln!(
+            s,
+            "size:        {} x {} x {} model units; built: {} x {} x {} mm ({} mm per unit)",
+            fmt_num(size[0]),
+            fmt_num(size[1]),
+            fmt_num(size[2]),
+            fmt_num(self.physical.size_mm[0]),
+            fmt_num(self.physical.size_mm[1]),
+            fmt_num(self.physical.size_mm[2]),
+            fmt_num(self.physical.mm_per_unit)
+        );
+        let _ = writeln!(
+            s,
+            "area:        {} square model units; built: {} m²",
+            fmt_num(g.surface_area),
+            fmt_num(self.physical.surface_area_mm2 / 1e6)
+        );
+        let _ = writeln!(
+            s,
+            "planarity:   max error {:.3e}; {} faces above {}",
+            g.max_planarity_error, g.non_planar_faces, g.planarity_tolerance
+        );
+        if !self.groups.is_empty() {
+            let names: Vec<&str> = self.groups.iter().map(|g| g.name.as_str()).collect();
+            let _ = writeln!(s, "groups:      {}", names.join(", "));
+        }
+        if !self.ignored.is_empty() {
+            let ignored: Vec<String> = self
+                .ignored
+                .iter()
+                .map(|(k, n)| format!("{k} ×{n}"))
+                .collect();
+            let _ = writeln!(s, "ignored:     {}", ignored.join(", "));
+        }
+        if self.notes.is_empty() {
+            let _ = writeln!(s, "notes:       none; the mesh is clean");
+        } else {
+            let _ = writeln!(s, "notes:");
+            for note in &self.notes {
+                let _ = writeln!(s, "  - {}", note.message);
+            }
+        }
+        s
+    }
+}
+
+/// A number with at most 4 decimals, trailing zeros trimmed (for reports).
+fn fmt_num(x: f64) -> String {
+    let s = format!("{x:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}

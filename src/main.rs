@@ -1,0 +1,131 @@
+//! The `unfold` command line: parse options, merge the configuration file, call the
+//! library, print the report, turn the result into an exit code. Nothing else.
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use unfold::config::{load_config, BuildOptions, ModelOptions};
+use unfold::{Error, Result};
+
+/// Turn a 3D polygon mesh into developable flat panels laid out on laser-cutter sheets.
+///
+/// Exit codes: 0 success, 1 runtime failure, 2 usage error, 3 bad input model.
+#[derive(Debug, Parser)]
+#[command(
+    name = "unfold",
+    version,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true,
+    after_help = "Lengths take a unit: mm, cm, m, in, ft (4ft, 0.25in, 600mm).\n\
+                  Examples:\n  unfold inspect models/genus2.obj\n  \
+                  unfold bunny.obj --scheme quad-edge --sheet 18x24in --size 4ft --out build/bunny"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+
+    /// The model to build: .obj, .off or .stl.
+    #[arg(value_name = "MODEL", required = true)]
+    model: Option<PathBuf>,
+
+    /// Read options from a TOML file (keys are the long option names, e.g.
+    /// sheet = "18x24in"); options on the command line win.
+    #[arg(long, value_name = "FILE")]
+    config: Option<PathBuf>,
+
+    #[command(flatten)]
+    build: BuildOptions,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Print a model's topology and geometry (V, E, F, face sizes, boundary loops,
+    /// components, genus, size, planarity) and every repair the tool would make.
+    Inspect {
+        /// The model: .obj, .off or .stl.
+        #[arg(value_name = "MODEL")]
+        model: PathBuf,
+
+        /// Print the facts as JSON on stdout instead of text.
+        #[arg(long)]
+        json: bool,
+
+        /// Read options from a TOML file; options on the command line win.
+        #[arg(long, value_name = "FILE")]
+        config: Option<PathBuf>,
+
+        #[command(flatten)]
+        options: ModelOptions,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("unfold: error: {e}");
+            let mut source = std::error::Error::source(&e);
+            while let Some(cause) = source {
+                eprintln!("  caused by: {cause}");
+                source = cause.source();
+            }
+            ExitCode::from(e.exit_code() as u8)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Some(Command::Inspect {
+            model,
+            json,
+            config,
+            options,
+        }) => {
+            let options = match config {
+                Some(path) => options.or(load_config::<ModelOptions>(&path)?),
+                None => options,
+            };
+            let settings = options.resolve()?;
+            let report = unfold::inspect(&model, &settings)?;
+            let text = if json {
+                serde_json::to_string_pretty(&report)
+                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?
+                    + "\n"
+            } else {
+                report.to_text()
+            };
+            // A closed pipe (`| head`) is not an error worth a panic.
+            let _ = std::io::stdout().lock().write_all(text.as_bytes());
+            Ok(())
+        }
+        None => {
+            let model = cli
+                .model
+                .ok_or_else(|| Error::Usage("give a model file".to_string()))?;
+            let options = match cli.config {
+                Some(path) => cli.build.or(load_config::<BuildOptions>(&path)?),
+                None => cli.build,
+            };
+            let job = options.resolve(&model)?;
+            let (_, prepared) = unfold::load_model(&job.model_path, &job.model)?;
+            eprintln!(
+                "{}: {} vertices, {} edges, {} faces, ready for the {} scheme",
+                job.model_path.display(),
+                prepared.mesh.vertex_count(),
+                prepared.mesh.edge_count(),
+                prepared.mesh.face_count(),
+                job.scheme
+            );
+            Err(Error::Runtime(
+                "building panels and sheets is not implemented yet in this version; \
+                 `unfold inspect MODEL` reports what the tool knows about the model"
+                    .to_string(),
+            ))
+        }
+    }
+}

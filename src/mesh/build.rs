@@ -1,0 +1,275 @@
+//! Building the half-edge mesh from polygons in O(n log n): one sort of the face corners
+//! by undirected edge pairs the half-edges, a union-find over corners finds vertex fans.
+
+use glam::DVec3;
+
+use super::halfedge::{Mesh, NO_FACE};
+use super::ids::{HalfEdgeId, VertexId};
+use super::polygons::Polygons;
+use super::soup::{corner_edge, corner_fans, CornerEdges};
+
+/// Why a polygon soup cannot become a half-edge mesh. Indices are the soup's own
+/// (0-based); the prepare stage translates them into the user's file numbering.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum BuildError {
+    /// A face with fewer than three corners.
+    #[error("face {face} has {corners} corners; a face needs at least 3")]
+    TooFewCorners { face: u32, corners: u32 },
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {vertex}, but there are only {count} vertices")]
+    IndexOutOfRange { face: u32, vertex: u32, count: u32 },
+    /// A face visits the same vertex twice.
+    #[error("face {face} uses vertex {vertex} more than once")]
+    RepeatedVertex { face: u32, vertex: u32 },
+    /// An edge shared by more than two faces.
+    #[error("edge {a}-{b} is shared by {} faces", faces.len())]
+    NonManifoldEdge { a: u32, b: u32, faces: Vec<u32> },
+    /// Two faces run through their shared edge in the same direction.
+    #[error("faces {} and {} run through edge {a}-{b} in the same direction", faces[0], faces[1])]
+    InconsistentOrientation { a: u32, b: u32, faces: [u32; 2] },
+    /// A vertex no face uses (the prepare stage drops these before building).
+    #[error("vertex {vertex} is used by no face")]
+    IsolatedVertex { vertex: u32 },
+    /// More elements than `u32` handles can address.
+    #[error("the mesh has more than 2^31 edges or corners")]
+    TooLarge,
+}
+
+/// Repairs the builder made: bow-tie vertices split into one vertex per fan.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct BuildReport {
+    /// For every split vertex: its soup index and the number of fans it had.
+    pub split_vertices: Vec<(u32, u32)>,
+}
+
+/// Checks that every face has ≥ 3 distinct, in-range corners.
+pub(crate) fn check_faces(polys: &Polygons) -> Result<(), BuildError> {
+    let count = polys.positions.len() as u32;
+    let mut seen: Vec<u32> = Vec::new();
+    for (f, face) in polys.faces().enumerate() {
+        let face_id = f as u32;
+        if face.len() < 3 {
+            return Err(BuildError::TooFewCorners {
+                face: face_id,
+                corners: face.len() as u32,
+            });
+        }
+        if let Some(&vertex) = face.iter().find(|&&v| v >= count) {
+            return Err(BuildError::IndexOutOfRange {
+                face: face_id,
+                vertex,
+                count,
+            });
+        }
+        seen.clear();
+        seen.extend_from_slice(face);
+        seen.sort_unstable();
+        if let Some(w) = seen.windows(2).find(|w| w[0] == w[1]) {
+            return Err(BuildError::RepeatedVertex {
+                face: face_id,
+                vertex: w[0],
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Builds the half-edge mesh of a consistently oriented, edge-manifold polygon soup.
+///
+/// Every vertex must be used by a face (the prepare stage drops the others). Bow-tie vertices (several fans meeting
+/// at one point) are split into one vertex per fan and listed in the report.
+///
+/// `vertex_source` and `face_source` map soup indices to the user's input indices; pass
+/// `None` for the identity.
+pub fn build_mesh(
+    polys: &Polygons,
+    vertex_source: Option<&[u32]>,
+    face_source: Option<&[u32]>,
+) -> Result<(Mesh, BuildReport), BuildError> {
+    if polys.indices.len() >= (1usize << 31) {
+        return Err(BuildError::TooLarge);
+    }
+    check_faces(polys)?;
+    let corners = CornerEdges::new(polys);
+    let corner_count = polys.indices.len();
+
+    // Pair corners into edges; edges are numbered in the order their first corner
+    // appears in the file, so edge ids follow the user's face order.
+    let mut group_of_corner = vec![0u32; corner_count];
+    let mut group_count = 0u32;
+    for group in corners.groups() {
+        if group.len() > 2 {
+            let (a, b) = corner_edge(polys, &corners.corner_face, group[0].1);
+            let faces = group
+                .iter()
+                .map(|&(_, c)| corners.corner_face[c as usize])
+                .collect();
+            return Err(BuildError::NonManifoldEdge {
+                a: a.min(b),
+                b: a.max(b),
+                faces,
+            });
+        }
+        if let [(_, c1), (_, c2)] = *group {
+            let e1 = corner_edge(polys, &corners.corner_face, c1);
+            let e2 = corner_edge(polys, &corners.corner_face, c2);
+            if e1 == e2 {
+                return Err(BuildError::InconsistentOrientation {
+                    a: e1.0,
+                    b: e1.1,
+                    faces: [
+                        corners.corner_face[c1 as usize],
+                        corners.corner_face[c2 as usize],
+                    ],
+                });
+            }
+        }
+        for &(_, c) in group {
+            group_of_corner[c as usize] = group_count;
+        }
+        group_count += 1;
+    }
+    let fans = corner_fans(polys, &corners);
+    drop(corners);
+
+    let mut edge_of_group = vec![u32::MAX; group_count as usize];
+    let mut corner_half_edge = vec![HalfEdgeId(0); corner_count];
+    let mut edge_count = 0u32;
+    for (c, &g) in group_of_corner.iter().enumerate() {
+        let slot = &mut edge_of_group[g as usize];
+        corner_half_edge[c] = if *slot == u32::MAX {
+            *slot = edge_count;
+            edge_count += 1;
+            HalfEdgeId(2 * *slot)
+        } else {
+            HalfEdgeId(2 * *slot + 1)
+        };
+    }
+    drop(group_of_corner);
+    drop(edge_of_group);
+
+    let half_edge_count = 2 * edge_count as usize;
+    let unset = HalfEdgeId(u32::MAX);
+    let mut next = vec![unset; half_edge_count];
+    let mut prev = vec![unset; half_edge_count];
+    let mut face_of = vec![NO_FACE; half_edge_count];
+    let mut face_half_edge = Vec::with_capacity(polys.face_count());
+    for f in 0..polys.face_count() {
+        let (start, end) = (polys.offsets[f] as usize, polys.offsets[f + 1] as usize);
+        face_half_edge.push(corner_half_edge[start]);
+        for c in start..end {
+            let h = corner_half_edge[c].index();
+            let n = if c + 1 == end { start } else { c + 1 };
+            let hn = corner_half_edge[n];
+            next[h] = hn;
+            prev[hn.index()] = HalfEdgeId(h as u32);
+            face_of[h] = f as u32;
+        }
+    }
+
+    // One vertex per fan: the first fan of a soup vertex keeps its index, later fans
+    // get new vertices appended (in half-edge order, so the result is deterministic).
+    let soup_vertex_count = polys.positions.len();
+    let mut positions = polys.positions.clone();
+    let mut vertex_source_out: Vec<u32> = match vertex_source {
+        Some(s) => s.to_vec(),
+        None => (0..soup_vertex_count as u32).collect(),
+    };
+    let mut first_root = vec![u32::MAX; soup_vertex_count];
+    let mut vertex_of_root = vec![u32::MAX; corner_count];
+    let mut fans_of_vertex: Vec<(u32, u32)> = Vec::new();
+    let mut origin = vec![VertexId(u32::MAX); half_edge_count];
+    for (c, &root) in fans.iter().enumerate() {
+        let root = root as usize;
+        if vertex_of_root[root] == u32::MAX {
+            let sv = polys.indices[c] as usize;
+            if first_root[sv] == u32::MAX {
+                first_root[sv] = root as u32;
+                vertex_of_root[root] = sv as u32;
+            } else {
+                vertex_of_root[root] = positions.len() as u32;
+                positions.push(positions[sv]);
+                vertex_source_out.push(vertex_source_out[sv]);
+                fans_of_vertex.push((sv as u32, 0));
+            }
+        }
+        origin[corner_half_edge[c].index()] = VertexId(vertex_of_root[root]);
+    }
+    drop(fans);
+    drop(vertex_of_root);
+    drop(corner_half_edge);
+
+    // Boundary half-edges: the twin of face half-edge u→w runs w→u; its origin is the
+    // origin of next(h). Each (post-split) vertex has at most one outgoing boundary
+    // half-edge, so boundary loops link without ambiguity.
+    let vertex_count = positions.len();
+    let mut boundary_out = vec![unset; vertex_count];
+    for h in 0..half_edge_count {
+        if face_of[h] == NO_FACE {
+            let interior = HalfEdgeId(h as u32).twin();
+            let o = origin[next[interior.index()].index()];
+            origin[h] = o;
+            boundary_out[o.index()] = HalfEdgeId(h as u32);
+        }
+    }
+    for h in 0..half_edge_count {
+        if face_of[h] == NO_FACE {
+            let head = origin[HalfEdgeId(h as u32).twin().index()];
+            let n = boundary_out[head.index()];
+            next[h] = n;
+            prev[n.index()] = HalfEdgeId(h as u32);
+        }
+    }
+
+    let mut vertex_half_edge = vec![unset; vertex_count];
+    for h in (0..half_edge_count).rev() {
+        // Reverse order so the lowest outgoing half-edge wins for interior vertices.
+        vertex_half_edge[origin[h].index()] = HalfEdgeId(h as u32);
+    }
+    for (v, &b) in boundary_out.iter().enumerate() {
+        if b != unset {
+            vertex_half_edge[v] = b;
+        }
+    }
+    if let Some(v) = vertex_half_edge.iter().position(|&h| h == unset) {
+        return Err(BuildError::IsolatedVertex { vertex: v as u32 });
+    }
+
+    let mut report = BuildReport::default();
+    if !fans_of_vertex.is_empty() {
+        let mut counts = std::collections::BTreeMap::new();
+        for (sv, _) in fans_of_vertex {
+            *counts.entry(sv).or_insert(1u32) += 1;
+        }
+        report.split_vertices = counts
+            .into_iter()
+            .map(|(sv, n)| (vertex_source_out[sv as usize], n))
+            .collect();
+    }
+
+    let face_source_out = match face_source {
+        Some(s) => s.to_vec(),
+        None => (0..polys.face_count() as u32).collect(),
+    };
+    let mesh = Mesh {
+        positions,
+        vertex_half_edge,
+        half_edge_next: next,
+        half_edge_prev: prev,
+        half_edge_origin: origin,
+        half_edge_face: face_of,
+        face_half_edge,
+        vertex_source: vertex_source_out,
+        face_source: face_source_out,
+    };
+    Ok((mesh, report))
+}
+
+/// A convenience for tests and examples: builds from positions and face lists.
+pub fn build_from_faces<F: AsRef<[u32]>>(
+    positions: Vec<DVec3>,
+    faces: &[F],
+) -> Result<Mesh, BuildError> {
+    let polys = Polygons::from_faces(positions, faces);
+    build_mesh(&polys, None, None).map(|(mesh, _)| mesh)
+}

@@ -1,0 +1,211 @@
+//! Model readers: OBJ, OFF and STL into a [`RawModel`] (a polygon soup that remembers
+//! where every face is in the file, so later messages can point at a line).
+//!
+//! OBJ is read by our own parser rather than `tobj`: tobj reports errors without a line
+//! number, renumbers positions per object (so `o`/`g` groups sharing vertices would come
+//! apart at every group border) and silently drops unreferenced vertices, and this tool
+//! must name lines, keep groups joined and report what it drops.
+
+mod obj;
+mod off;
+mod stl;
+
+use std::path::{Path, PathBuf};
+
+use crate::error::{InputError, Location};
+
+use super::polygons::Polygons;
+
+/// The file formats the tool reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Format {
+    /// Wavefront OBJ (polygons kept as they are).
+    Obj,
+    /// Object File Format (Geomview OFF, COFF, NOFF).
+    Off,
+    /// STL, ASCII or binary (triangle soup, welded by position).
+    Stl,
+}
+
+impl Format {
+    /// The format of a path, from its extension (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(Format::Obj),
+            "off" => Some(Format::Off),
+            "stl" => Some(Format::Stl),
+            _ => None,
+        }
+    }
+
+    /// How the format numbers vertices in messages: OBJ counts from 1, the others
+    /// from 0.
+    pub fn index_base(self) -> u32 {
+        match self {
+            Format::Obj => 1,
+            Format::Off | Format::Stl => 0,
+        }
+    }
+}
+
+/// A named run of faces (an OBJ `o` or `g` statement).
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Group {
+    /// The name as written in the file.
+    pub name: String,
+    /// Index of the group's first face.
+    pub first_face: u32,
+}
+
+/// A model as read: positions and faces exactly as the file gives them.
+#[derive(Clone, Debug)]
+pub struct RawModel {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Its format.
+    pub format: Format,
+    /// Positions and faces, 0-based.
+    pub polys: Polygons,
+    /// Where each face is in the file: a 1-based line for text files, the byte offset
+    /// of the facet for binary STL.
+    pub face_locations: Vec<u64>,
+    /// True when `face_locations` are byte offsets.
+    pub binary: bool,
+    /// Named groups, in file order.
+    pub groups: Vec<Group>,
+    /// Statements read but not used (texture coordinates, normals, materials…), with
+    /// how many of each; reported so that nothing is dropped silently.
+    pub ignored: Vec<(String, usize)>,
+    /// For STL: how many corner copies were merged when welding the triangle soup.
+    pub welded_corners: usize,
+}
+
+impl RawModel {
+    /// Where face `f` is in the file.
+    pub fn face_location(&self, f: usize) -> Location {
+        match self.face_locations.get(f) {
+            Some(&n) if self.binary => Location::Byte(n),
+            Some(&n) => Location::Line(n),
+            None => Location::File,
+        }
+    }
+
+    /// A vertex index as the user's file writes it (1-based in OBJ).
+    pub fn vertex_label(&self, v: u32) -> u64 {
+        v as u64 + self.format.index_base() as u64
+    }
+}
+
+/// Reads a model file. The format comes from the extension.
+pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
+    let Some(format) = Format::from_path(path) else {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "unknown model format",
+            "give a .obj, .off or .stl file",
+        ));
+    };
+    if path.is_dir() {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "is a directory, not a model file",
+            "give the path of a .obj, .off or .stl file",
+        ));
+    }
+    let bytes = std::fs::read(path).map_err(|e| {
+        let problem = match e.kind() {
+            std::io::ErrorKind::NotFound => "no such file".to_string(),
+            std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
+            _ => format!("cannot read the file: {e}"),
+        };
+        InputError::new(
+            path,
+            Location::File,
+            problem,
+            "check the path and permissions",
+        )
+    })?;
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "the file is empty",
+            "export the model again",
+        ));
+    }
+    let model = match format {
+        Format::Obj => obj::parse(path, &bytes)?,
+        Format::Off => off::parse(path, &bytes)?,
+        Format::Stl => stl::parse(path, &bytes)?,
+    };
+    if model.polys.face_count() == 0 {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "the file has no faces",
+            "a model for unfolding needs polygon faces; export faces, not only points or lines",
+        ));
+    }
+    Ok(model)
+}
+
+/// Lines of a text file with their 1-based numbers. Rejects binary data with a message
+/// that says so, instead of reporting nonsense numbers further on.
+pub(crate) fn text_lines<'a>(
+    path: &'a Path,
+    bytes: &'a [u8],
+    what: &'static str,
+) -> impl Iterator<Item = Result<(u64, &'a str), InputError>> + 'a {
+    bytes
+        .split(|&b| b == b'\n')
+        .enumerate()
+        .map(move |(i, raw)| {
+            let line_no = i as u64 + 1;
+            let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+            if raw.contains(&0) {
+                return Err(InputError::new(
+                    path,
+                    Location::Line(line_no),
+                    format!("binary data in a text {what} file"),
+                    format!("is this really a {what} file? export it again as text"),
+                ));
+            }
+            match std::str::from_utf8(raw) {
+                Ok(s) => Ok((line_no, s)),
+                Err(_) => Err(InputError::new(
+                    path,
+                    Location::Line(line_no),
+                    "the line is not valid UTF-8 text",
+                    format!("is this really a {what} file? export it again as UTF-8 text"),
+                )),
+            }
+        })
+}
+
+/// Parses one finite coordinate, naming the token when it fails.
+pub(crate) fn parse_coordinate(
+    path: &Path,
+    line: u64,
+    token: &str,
+    what: &str,
+) -> Result<f64, InputError> {
+    match token.parse::<f64>() {
+        Ok(x) if x.is_finite() => Ok(x),
+        Ok(_) => Err(InputError::new(
+            path,
+            Location::Line(line),
+            format!("{what} coordinate '{token}' is not a finite number"),
+            "replace NaN or infinite coordinates with real positions",
+        )),
+        Err(_) => Err(InputError::new(
+            path,
+            Location::Line(line),
+            format!("'{token}' is not a number in this {what}"),
+            "fix the number or export the model again",
+        )),
+    }
+}
