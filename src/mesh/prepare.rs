@@ -6,13 +6,15 @@
 //! unreferenced vertices, then the optional weld, then the edge-manifold check, then
 //! orientation, then the half-edge build (which splits bow-tie vertices).
 
-use std::collections::{HashMap, VecDeque};
+use std::collections::VecDeque;
 
 use serde::Serialize;
 
 use super::build::{build_mesh, BuildError};
 use super::geometry::diameter;
 use super::halfedge::Mesh;
+use rayon::slice::ParallelSliceMut;
+
 use super::polygons::Polygons;
 use super::read::{Group, RawModel};
 use super::soup::{corner_edge, soup_facts, CornerEdges, SoupFacts};
@@ -157,8 +159,10 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
         face_source: &face_source,
         vertex_source: &vertex_source,
     };
-    check_edge_manifold(&polys, &located)?;
-    orient(&mut polys, &located, &mut notes)?;
+    let edges = CornerEdges::new(&polys);
+    check_edge_manifold(&polys, &edges, &located)?;
+    orient(&mut polys, &edges, &located, &mut notes)?;
+    drop(edges);
 
     let (mesh, report) = build_mesh(&polys, Some(&vertex_source), Some(&face_source))
         .map_err(|e| located.build_error(e))?;
@@ -273,7 +277,6 @@ fn clean_faces(raw: &RawModel, notes: &mut Vec<Note>) -> (Polygons, Vec<u32>) {
     let mut pinched = Vec::new();
     let mut zero_area = Vec::new();
     let mut duplicates = Vec::new();
-    let mut seen: HashMap<Vec<u32>, u32> = HashMap::new();
     let mut corners: Vec<u32> = Vec::new();
     let mut sorted: Vec<u32> = Vec::new();
     let mut points = Vec::new();
@@ -309,14 +312,10 @@ fn clean_faces(raw: &RawModel, notes: &mut Vec<Note>) -> (Polygons, Vec<u32>) {
             zero_area.push(f);
             continue;
         }
-        if let Some(&first) = seen.get(&sorted) {
-            duplicates.push((f, first));
-            continue;
-        }
-        seen.insert(sorted.clone(), f as u32);
         out.push_face(&corners);
         face_source.push(f as u32);
     }
+    let (out, face_source) = drop_duplicate_faces(out, face_source, &mut duplicates);
     let face_name = |f: usize| match raw.face_location(f) {
         Location::Line(n) => format!("face {f} (line {n})"),
         Location::Byte(n) => format!("triangle {f} (byte {n})"),
@@ -370,6 +369,77 @@ fn clean_faces(raw: &RawModel, notes: &mut Vec<Note>) -> (Polygons, Vec<u32>) {
         });
     }
     (out, face_source)
+}
+
+/// Drops faces with the same set of corners as an earlier face. Faces are sorted by a
+/// hash of their sorted corners and only equal hashes are compared, so no per-face
+/// allocation is needed. `duplicates` receives (dropped face, earlier face) in the
+/// file's numbering.
+fn drop_duplicate_faces(
+    polys: Polygons,
+    face_source: Vec<u32>,
+    duplicates: &mut Vec<(usize, u32)>,
+) -> (Polygons, Vec<u32>) {
+    let sorted_corners = |f: usize| {
+        let mut c = polys.face(f).to_vec();
+        c.sort_unstable();
+        c
+    };
+    let mut keyed: Vec<(u64, u32)> = (0..polys.face_count())
+        .map(|f| {
+            let mut corners: [u32; 8] = [u32::MAX; 8];
+            let face = polys.face(f);
+            // Hash of the sorted corners; long faces hash their 8 smallest corners.
+            let mut buf: Vec<u32>;
+            let sorted: &[u32] = if face.len() <= 8 {
+                corners[..face.len()].copy_from_slice(face);
+                corners[..face.len()].sort_unstable();
+                &corners[..face.len()]
+            } else {
+                buf = face.to_vec();
+                buf.sort_unstable();
+                &buf
+            };
+            let mut h: u64 = 0xcbf2_9ce4_8422_2325 ^ sorted.len() as u64;
+            for &v in sorted {
+                h = (h ^ v as u64).wrapping_mul(0x0100_0000_01b3);
+            }
+            (h, f as u32)
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    let mut drop = vec![false; polys.face_count()];
+    for run in keyed.chunk_by(|a, b| a.0 == b.0).filter(|r| r.len() > 1) {
+        for (k, &(_, f)) in run.iter().enumerate() {
+            let corners = sorted_corners(f as usize);
+            if let Some(&(_, first)) = run[..k]
+                .iter()
+                .find(|&&(_, g)| !drop[g as usize] && sorted_corners(g as usize) == corners)
+            {
+                drop[f as usize] = true;
+                duplicates.push((
+                    face_source[f as usize] as usize,
+                    face_source[first as usize],
+                ));
+            }
+        }
+    }
+    if duplicates.is_empty() {
+        return (polys, face_source);
+    }
+    duplicates.sort_unstable();
+    let mut out = Polygons {
+        positions: polys.positions.clone(),
+        ..Polygons::new()
+    };
+    let mut source = Vec::with_capacity(face_source.len());
+    for f in 0..polys.face_count() {
+        if !drop[f] {
+            out.push_face(polys.face(f));
+            source.push(face_source[f]);
+        }
+    }
+    (out, source)
 }
 
 /// Sum of the triangle areas of a fan from the centroid: zero only when every corner
@@ -428,8 +498,11 @@ fn drop_unreferenced(polys: Polygons, previous_source: Option<&[u32]>) -> (Polyg
 }
 
 /// Rejects edges shared by three or more faces, naming the first one.
-fn check_edge_manifold(polys: &Polygons, at: &Located) -> Result<(), InputError> {
-    let edges = CornerEdges::new(polys);
+fn check_edge_manifold(
+    polys: &Polygons,
+    edges: &CornerEdges,
+    at: &Located,
+) -> Result<(), InputError> {
     let mut worst: Option<&[(u64, u32)]> = None;
     let mut count = 0usize;
     for group in edges.groups() {
@@ -470,26 +543,42 @@ fn check_edge_manifold(polys: &Polygons, at: &Located) -> Result<(), InputError>
 /// Orients every component consistently (flipping the minority of its faces), then
 /// turns closed components outward (positive enclosed volume). Rejects non-orientable
 /// components.
-fn orient(polys: &mut Polygons, at: &Located, notes: &mut Vec<Note>) -> Result<(), InputError> {
+fn orient(
+    polys: &mut Polygons,
+    edges: &CornerEdges,
+    at: &Located,
+    notes: &mut Vec<Note>,
+) -> Result<(), InputError> {
     let face_count = polys.face_count();
     // Neighbours across each shared edge, and whether they run through it the same way
-    // (then exactly one of the two must be flipped).
-    let mut neighbours: Vec<Vec<(u32, bool)>> = vec![Vec::new(); face_count];
-    {
-        let edges = CornerEdges::new(polys);
-        for group in edges.groups() {
-            if let [(_, c1), (_, c2)] = *group {
-                let (f1, f2) = (
-                    edges.corner_face[c1 as usize],
-                    edges.corner_face[c2 as usize],
-                );
-                let same = corner_edge(polys, &edges.corner_face, c1)
-                    == corner_edge(polys, &edges.corner_face, c2);
-                neighbours[f1 as usize].push((f2, same));
-                neighbours[f2 as usize].push((f1, same));
-            }
+    // (then exactly one of the two must be flipped), in compressed rows: face f's
+    // neighbours are `pairs[row[f]..row[f + 1]]`.
+    let mut pairs: Vec<(u32, u32, bool)> = Vec::with_capacity(polys.indices.len());
+    for group in edges.groups() {
+        if let [(_, c1), (_, c2)] = *group {
+            let (f1, f2) = (
+                edges.corner_face[c1 as usize],
+                edges.corner_face[c2 as usize],
+            );
+            let same = corner_edge(polys, &edges.corner_face, c1)
+                == corner_edge(polys, &edges.corner_face, c2);
+            pairs.push((f1, f2, same));
+            pairs.push((f2, f1, same));
         }
     }
+    pairs.sort_unstable();
+    let mut row = vec![0usize; face_count + 1];
+    for &(f, _, _) in &pairs {
+        row[f as usize + 1] += 1;
+    }
+    for f in 0..face_count {
+        row[f + 1] += row[f];
+    }
+    let neighbours_of = |f: usize| {
+        pairs[row[f]..row[f + 1]]
+            .iter()
+            .map(|&(_, g, same)| (g, same))
+    };
     let mut flip = vec![false; face_count];
     let mut component = vec![u32::MAX; face_count];
     let mut flipped_faces = Vec::new();
@@ -507,10 +596,10 @@ fn orient(polys: &mut Polygons, at: &Located, notes: &mut Vec<Note>) -> Result<(
         let mut closed = true;
         while let Some(f) = queue.pop_front() {
             members.push(f);
-            if neighbours[f].len() < polys.face(f).len() {
+            if row[f + 1] - row[f] < polys.face(f).len() {
                 closed = false;
             }
-            for &(g, same) in &neighbours[f] {
+            for (g, same) in neighbours_of(f) {
                 let want = flip[f] ^ same;
                 let g = g as usize;
                 if component[g] == u32::MAX {

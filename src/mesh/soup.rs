@@ -1,6 +1,8 @@
 //! Topology of a polygon soup before it is a half-edge mesh: corners grouped by edge,
 //! vertex fans, and the facts of the input exactly as the file gives it.
 
+use rayon::slice::ParallelSliceMut;
+
 use super::polygons::Polygons;
 
 /// Face corners grouped by undirected edge. Corner `c` is the corner at `indices[c]`;
@@ -28,7 +30,8 @@ impl CornerEdges {
                 (edge_key(a, b), c)
             })
             .collect();
-        sorted.sort_unstable();
+        // Keys are unique (corner index breaks ties): parallel sort stays deterministic.
+        sorted.par_sort_unstable();
         Self {
             corner_face,
             sorted,

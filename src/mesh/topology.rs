@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 
 use glam::DVec3;
+use rayon::prelude::*;
 use serde::Serialize;
 
 use super::geometry::planarity_error;
@@ -194,13 +195,14 @@ impl Mesh {
     }
 
     /// The planarity error of every face (see [`super::geometry::planarity_error`]).
+    /// Computed in parallel; results are collected in face order.
     pub fn face_planarity_errors(&self) -> Vec<f64> {
-        let mut corners = Vec::new();
-        self.faces()
-            .map(|f| {
+        (0..self.face_count() as u32)
+            .into_par_iter()
+            .map_init(Vec::new, |corners, f| {
                 corners.clear();
-                corners.extend(self.face_positions(f));
-                planarity_error(&corners)
+                corners.extend(self.face_positions(FaceId(f)));
+                planarity_error(corners)
             })
             .collect()
     }

@@ -4,9 +4,9 @@
 //! keep coincident vertices apart unless `--weld` is given, because a seam may be
 //! intentional; `--weld` then merges only where the result stays a 2-manifold.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
+
+use rayon::slice::ParallelSliceMut;
 
 use super::polygons::Polygons;
 use super::soup::{fan_counts, CornerEdges};
@@ -27,49 +27,97 @@ pub fn weld_tolerance(points: &[DVec3]) -> f64 {
     }
 }
 
-/// Groups points closer than `tolerance`. Returns, for every point, the index of its
-/// cluster's representative: the first point (in index order) of the cluster, so the
-/// result is deterministic. A uniform grid with cells of the tolerance's size finds
-/// neighbours in expected O(1).
+/// Groups points closer than `tolerance` (transitively). Returns, for every point,
+/// the index of its cluster's representative: the cluster's lowest index, so the result
+/// does not depend on processing order.
+///
+/// Points are bucketed in a grid of cells much larger than the tolerance, sorted by
+/// cell; a point looks into a neighbouring cell only along the axes where it lies
+/// within the tolerance of its cell's border, so almost every point searches one cell.
 pub fn cluster_positions(points: &[DVec3], tolerance: f64) -> Vec<u32> {
-    let cell = if tolerance > 0.0 { tolerance } else { 1.0 };
-    let key = |p: DVec3| -> [i64; 3] {
-        let q = (p / cell).floor();
+    let mut parent: Vec<u32> = (0..points.len() as u32).collect();
+    if points.is_empty() {
+        return parent;
+    }
+    let (lo, hi) = points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    );
+    let diagonal = (hi - lo).length();
+    if diagonal.is_nan() || diagonal <= 0.0 {
+        // Every point at one position (or none finite): one cluster.
+        return vec![0; points.len()];
+    }
+    // At most 2^20 cells per axis, so a cell packs into 63 bits exactly.
+    let cell = (tolerance * 1024.0).max(diagonal / f64::from(1u32 << 20));
+    let cell_of = |p: DVec3| -> [i64; 3] {
+        let q = ((p - lo) / cell).floor();
         [q.x as i64, q.y as i64, q.z as i64]
     };
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
-    let mut representative = Vec::with_capacity(points.len());
+    let pack = |c: [i64; 3]| -> Option<u64> {
+        let limit = 1i64 << 21;
+        c.iter()
+            .all(|&k| (0..limit).contains(&k))
+            .then(|| ((c[0] as u64) << 42) | ((c[1] as u64) << 21) | c[2] as u64)
+    };
+    let mut sorted: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .filter_map(|(i, &p)| pack(cell_of(p)).map(|k| (k, i as u32)))
+        .collect();
+    sorted.par_sort_unstable();
+    let keys: Vec<u64> = sorted.iter().map(|&(k, _)| k).collect();
+    let close = |a: DVec3, b: DVec3| {
+        if tolerance > 0.0 {
+            a.distance(b) <= tolerance
+        } else {
+            a == b
+        }
+    };
     for (i, &p) in points.iter().enumerate() {
-        let k = key(p);
-        let mut found: Option<u32> = None;
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let Some(bucket) = grid.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else {
+        let home = cell_of(p);
+        let frac = (p - lo) / cell - DVec3::new(home[0] as f64, home[1] as f64, home[2] as f64);
+        let near = tolerance / cell;
+        // Per axis: the home cell, plus the neighbour on the side the point is near.
+        let steps = |f: f64| -> [i64; 2] {
+            if f < near {
+                [0, -1]
+            } else if f > 1.0 - near {
+                [0, 1]
+            } else {
+                [0, 0]
+            }
+        };
+        let (sx, sy, sz) = (steps(frac.x), steps(frac.y), steps(frac.z));
+        let mut visited: [Option<u64>; 8] = [None; 8];
+        let mut n = 0;
+        for dx in sx {
+            for dy in sy {
+                for dz in sz {
+                    let Some(key) = pack([home[0] + dx, home[1] + dy, home[2] + dz]) else {
                         continue;
                     };
-                    for &r in bucket {
-                        let close = if tolerance > 0.0 {
-                            points[r as usize].distance(p) <= tolerance
-                        } else {
-                            points[r as usize] == p
-                        };
-                        if close && found.is_none_or(|f| r < f) {
-                            found = Some(r);
+                    if visited[..n].contains(&Some(key)) {
+                        continue;
+                    }
+                    visited[n] = Some(key);
+                    n += 1;
+                    let start = keys.partition_point(|&k| k < key);
+                    for &(k, j) in &sorted[start..] {
+                        if k != key {
+                            break;
+                        }
+                        if (j as usize) < i && close(points[j as usize], p) {
+                            super::soup::union(&mut parent, i as u32, j);
                         }
                     }
                 }
             }
         }
-        match found {
-            Some(r) => representative.push(r),
-            None => {
-                grid.entry(k).or_default().push(i as u32);
-                representative.push(i as u32);
-            }
-        }
     }
-    representative
+    (0..points.len() as u32)
+        .map(|i| super::soup::find(&mut parent, i))
+        .collect()
 }
 
 /// What a manifold-aware weld did.
