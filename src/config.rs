@@ -202,7 +202,7 @@ pub struct ModelOptions {
     pub units: Option<LengthUnit>,
 
     /// Extra factor applied after --size or --units. [default: 1]
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub scale: Option<f64>,
 
     /// Merge vertices that share a position where the mesh stays manifold (OBJ and OFF

@@ -43,8 +43,17 @@ pub fn best_fit_plane(points: &[DVec3]) -> (DVec3, DVec3) {
     (centroid, normal)
 }
 
-/// The largest distance between two of the points (the polygon's diameter).
+/// The largest distance between two of the points (the polygon's diameter). Exact up
+/// to 64 points; beyond that the bounding-box diagonal (within a factor √3), so a
+/// polygon with thousands of corners costs O(n), not O(n²).
 pub fn diameter(points: &[DVec3]) -> f64 {
+    if points.len() > 64 {
+        let (lo, hi) = points.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        return (hi - lo).length();
+    }
     let mut best = 0.0f64;
     for (i, a) in points.iter().enumerate() {
         for b in &points[i + 1..] {

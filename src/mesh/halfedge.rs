@@ -194,6 +194,7 @@ impl Mesh {
             mesh: self,
             start,
             current: Some(start),
+            steps_left: self.half_edge_count(),
         }
     }
 
@@ -220,6 +221,7 @@ impl Mesh {
             mesh: self,
             start,
             current: Some(start),
+            steps_left: self.half_edge_count(),
         }
     }
 
@@ -264,6 +266,7 @@ pub struct LoopIter<'a> {
     mesh: &'a Mesh,
     start: HalfEdgeId,
     current: Option<HalfEdgeId>,
+    steps_left: usize,
 }
 
 impl Iterator for LoopIter<'_> {
@@ -271,17 +274,19 @@ impl Iterator for LoopIter<'_> {
     fn next(&mut self) -> Option<HalfEdgeId> {
         let h = self.current?;
         let n = self.mesh.next(h);
-        self.current = (n != self.start).then_some(n);
+        self.steps_left = self.steps_left.saturating_sub(1);
+        self.current = (n != self.start && self.steps_left > 0).then_some(n);
         Some(h)
     }
 }
 
 /// Turns around a vertex: from outgoing `h`, the next outgoing half-edge is
-/// `next(twin(h))`.
+/// `next(twin(h))`. Like [`LoopIter`], bounded by the half-edge count.
 pub struct VertexIter<'a> {
     mesh: &'a Mesh,
     start: HalfEdgeId,
     current: Option<HalfEdgeId>,
+    steps_left: usize,
 }
 
 impl Iterator for VertexIter<'_> {
@@ -289,7 +294,8 @@ impl Iterator for VertexIter<'_> {
     fn next(&mut self) -> Option<HalfEdgeId> {
         let h = self.current?;
         let n = self.mesh.next(h.twin());
-        self.current = (n != self.start).then_some(n);
+        self.steps_left = self.steps_left.saturating_sub(1);
+        self.current = (n != self.start && self.steps_left > 0).then_some(n);
         Some(h)
     }
 }

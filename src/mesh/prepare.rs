@@ -69,16 +69,19 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
             "the model has no area; check the export",
         ));
     }
+    let unused: Vec<u32> = unused_vertices(&polys).collect();
     let (mut polys, mut vertex_source) = drop_unreferenced(polys, None);
-    let unreferenced = raw.polys.positions.len() - polys.positions.len();
-    if unreferenced > 0 {
+    if !unused.is_empty() {
         notes.push(Note {
             kind: "unreferenced-vertices",
             message: format!(
-                "{unreferenced} vertices are used by no face and were dropped{}",
+                "{} vertices are used by no face and were dropped{}",
+                unused.len(),
                 examples(
-                    unused_vertices(&raw.polys).map(|v| format!("vertex {}", raw.vertex_label(v))),
-                    unreferenced
+                    unused
+                        .iter()
+                        .map(|&v| format!("vertex {}", raw.vertex_label(v))),
+                    unused.len()
                 )
             ),
         });

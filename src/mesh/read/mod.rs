@@ -137,6 +137,17 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
             "export the model again",
         ));
     }
+    if format != Format::Stl {
+        if let Some(at) = binary_data_at(&bytes) {
+            let what = if format == Format::Obj { "OBJ" } else { "OFF" };
+            return Err(InputError::new(
+                path,
+                Location::Byte(at as u64),
+                format!("binary data: this is not a text {what} file"),
+                format!("check the file; export the model again as {what}"),
+            ));
+        }
+    }
     let model = match format {
         Format::Obj => obj::parse(path, &bytes)?,
         Format::Off => off::parse(path, &bytes)?,
@@ -151,6 +162,21 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
         ));
     }
     Ok(model)
+}
+
+/// The offset of the first sign of binary content in the first 8 KiB (a NUL byte or a
+/// byte sequence that is not UTF-8), or `None` for text.
+pub(crate) fn binary_data_at(bytes: &[u8]) -> Option<usize> {
+    let head = &bytes[..bytes.len().min(8192)];
+    if let Some(at) = head.iter().position(|&b| b == 0) {
+        return Some(at);
+    }
+    match std::str::from_utf8(head) {
+        Ok(_) => None,
+        // A character cut by the 8 KiB boundary is not an error.
+        Err(e) if e.error_len().is_none() => None,
+        Err(e) => Some(e.valid_up_to()),
+    }
 }
 
 /// Lines of a text file with their 1-based numbers. Rejects binary data with a message
@@ -171,7 +197,7 @@ pub(crate) fn text_lines<'a>(
                     path,
                     Location::Line(line_no),
                     format!("binary data in a text {what} file"),
-                    format!("is this really a {what} file? export it again as text"),
+                    format!("is this really an {what} file? export it again as text"),
                 ));
             }
             match std::str::from_utf8(raw) {
@@ -180,7 +206,7 @@ pub(crate) fn text_lines<'a>(
                     path,
                     Location::Line(line_no),
                     "the line is not valid UTF-8 text",
-                    format!("is this really a {what} file? export it again as UTF-8 text"),
+                    format!("is this really an {what} file? export it again as UTF-8 text"),
                 )),
             }
         })

@@ -12,11 +12,13 @@ use crate::mesh::weld::{cluster_positions, weld_tolerance};
 
 /// Parses an STL file held in memory, binary or ASCII.
 pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<RawModel, InputError> {
+    // Binary headers often start with "solid" too: ASCII also needs text after it.
     let looks_ascii = bytes
         .iter()
         .skip_while(|b| b.is_ascii_whitespace())
         .take(5)
-        .eq(b"solid".iter());
+        .eq(b"solid".iter())
+        && super::binary_data_at(bytes).is_none();
     let binary_size = (bytes.len() >= 84).then(|| {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
         84 + 50 * n
