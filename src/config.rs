@@ -329,9 +329,65 @@ pub struct BuildOptions {
     #[arg(long, value_name = "LIST")]
     pub format: Option<String>,
 
+    /// Face band scale s: each panel corner moves toward the face centre,
+    /// s·v + (1−s)·c. [default: 1.0 for half-edge]
+    #[arg(long, value_name = "S")]
+    pub face_scale: Option<f64>,
+
+    /// Connectors on interior edges (half-edge scheme): tab or none. [default: tab]
+    #[arg(long, value_name = "KIND")]
+    pub connectors: Option<Connectors>,
+
+    /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
+    /// where the neighbour is smaller. [default: 8mm]
+    #[arg(long, value_name = "LENGTH")]
+    pub tab_height: Option<String>,
+
+    /// Fastener holes per connection (half-edge: 0, 1 or 2). [default: 0 for half-edge]
+    #[arg(long, value_name = "N")]
+    pub holes: Option<u32>,
+
+    /// Fastener hole diameter, with a unit. [default: 0.125in]
+    #[arg(long, value_name = "LENGTH")]
+    pub hole_diameter: Option<String>,
+
+    /// Cap height of engraved labels, with a unit; shrunk to fit each panel, left out
+    /// below 1.5 mm. [default: 4mm]
+    #[arg(long, value_name = "LENGTH")]
+    pub label_height: Option<String>,
+
+    /// What to do with faces that are not planar within --planarity-tol: triangulate
+    /// (split along the diagonal that folds least) or error. [default: triangulate]
+    #[arg(long, value_name = "POLICY")]
+    pub nonplanar: Option<NonPlanar>,
+
+    /// Rotation steps tried when laying panels on sheets (360°/N each). [default: 32]
+    #[arg(long, value_name = "N")]
+    pub rotations: Option<u32>,
+
     #[command(flatten)]
     #[serde(flatten)]
     pub model: ModelOptions,
+}
+
+/// Connector kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Connectors {
+    /// A glue or pin tab on one of the two panels.
+    Tab,
+    /// Nothing: panels meet edge to edge.
+    None,
+}
+
+/// What to do with non-planar faces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum NonPlanar {
+    /// Split them into triangles.
+    Triangulate,
+    /// Refuse the model.
+    Error,
 }
 
 /// Which files to write.
@@ -362,6 +418,12 @@ pub struct Job {
     pub out: PathBuf,
     /// File formats.
     pub formats: OutputFormats,
+    /// Scheme options (lengths in mm).
+    pub scheme_options: crate::scheme::SchemeOptions,
+    /// Non-planar face policy.
+    pub nonplanar: NonPlanar,
+    /// Rotation steps for the layout.
+    pub rotations: u32,
 }
 
 impl BuildOptions {
@@ -374,6 +436,14 @@ impl BuildOptions {
             spacing: self.spacing.or(other.spacing),
             out: self.out.or(other.out),
             format: self.format.or(other.format),
+            face_scale: self.face_scale.or(other.face_scale),
+            connectors: self.connectors.or(other.connectors),
+            tab_height: self.tab_height.or(other.tab_height),
+            holes: self.holes.or(other.holes),
+            hole_diameter: self.hole_diameter.or(other.hole_diameter),
+            label_height: self.label_height.or(other.label_height),
+            nonplanar: self.nonplanar.or(other.nonplanar),
+            rotations: self.rotations.or(other.rotations),
             model: self.model.or(other.model),
         }
     }
@@ -412,7 +482,48 @@ impl BuildOptions {
                     .unwrap_or_else(|| "unfold-out".to_string()),
             ),
         };
+        let length = |option: &str, value: &Option<String>, default: &str| {
+            let text = value.as_deref().unwrap_or(default);
+            let mm = parse_length(text).map_err(|e| usage(option, e))?;
+            if mm > 0.0 {
+                Ok(mm)
+            } else {
+                Err(usage(option, format!("'{text}' must be positive")))
+            }
+        };
+        let face_scale = self.face_scale.unwrap_or(1.0);
+        if !(face_scale > 0.0 && face_scale <= 1.0) {
+            return Err(usage(
+                "face-scale",
+                format!("{face_scale} must be greater than 0 and at most 1"),
+            ));
+        }
+        let holes = self.holes.unwrap_or(0);
+        if holes > 2 {
+            return Err(usage(
+                "holes",
+                format!("{holes} holes per connection; the half-edge scheme takes 0, 1 or 2"),
+            ));
+        }
+        let rotations = self.rotations.unwrap_or(32);
+        if !(1..=3600).contains(&rotations) {
+            return Err(usage(
+                "rotations",
+                format!("{rotations} must be between 1 and 3600"),
+            ));
+        }
+        let scheme_options = crate::scheme::SchemeOptions {
+            face_scale,
+            tabs: self.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
+            tab_height: length("tab-height", &self.tab_height, "8mm")?,
+            holes,
+            hole_diameter: length("hole-diameter", &self.hole_diameter, "0.125in")?,
+            label_height: length("label-height", &self.label_height, "4mm")?,
+        };
         Ok(Job {
+            scheme_options,
+            nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
+            rotations,
             model_path: model_path.to_path_buf(),
             model: self.model.resolve()?,
             scheme: self.scheme.unwrap_or(SchemeName::QuadEdge),

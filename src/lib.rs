@@ -8,11 +8,19 @@
 //! ```
 //!
 //! This crate is the library; the `unfold` binary only parses options and calls it.
-//! What exists so far: reading, preparation, the half-edge core and `inspect`.
 
 pub mod config;
 pub mod error;
+pub mod export;
+pub mod flatten;
+pub mod font;
+pub mod labels;
 pub mod mesh;
+pub mod nest;
+pub mod panel;
+pub mod plane;
+pub mod run;
+pub mod scheme;
 
 use std::path::Path;
 
@@ -20,6 +28,7 @@ use serde::Serialize;
 
 pub use config::{BuildOptions, Job, ModelOptions, ModelSettings};
 pub use error::{Error, InputError, Result};
+pub use run::{report_text, run, Outcome};
 
 use mesh::read::Group;
 use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};

@@ -36,6 +36,15 @@ struct Cli {
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
 
+    /// Print the manifest summary (without the per-panel list) and stage times as
+    /// JSON on stdout.
+    #[arg(long)]
+    json: bool,
+
+    /// Print nothing on stderr but errors.
+    #[arg(long)]
+    quiet: bool,
+
     #[command(flatten)]
     build: BuildOptions,
 }
@@ -138,20 +147,27 @@ fn run(cli: Cli) -> Result<()> {
                 None => cli.build,
             };
             let job = options.resolve(&model)?;
-            let (_, prepared) = unfold::load_model(&job.model_path, &job.model)?;
-            eprintln!(
-                "{}: {} vertices, {} edges, {} faces, ready for the {} scheme",
-                job.model_path.display(),
-                prepared.mesh.vertex_count(),
-                prepared.mesh.edge_count(),
-                prepared.mesh.face_count(),
-                job.scheme
-            );
-            Err(Error::Runtime(
-                "building panels and sheets is not implemented yet in this version; \
-                 `unfold inspect MODEL` reports what the tool knows about the model"
-                    .to_string(),
-            ))
+            let outcome = unfold::run(&job)?;
+            if !cli.quiet {
+                eprint!("{}", unfold::report_text(&outcome, &job.out));
+            }
+            if cli.json {
+                let mut summary = serde_json::to_value(&outcome.manifest)
+                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?;
+                if let Some(map) = summary.as_object_mut() {
+                    map.remove("panels");
+                    let times: serde_json::Map<String, serde_json::Value> = outcome
+                        .times
+                        .iter()
+                        .map(|(stage, t)| (format!("{stage}_ms"), (t.as_secs_f64() * 1e3).into()))
+                        .collect();
+                    map.insert("times".into(), times.into());
+                }
+                let text = serde_json::to_string_pretty(&summary)
+                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?;
+                let _ = writeln!(std::io::stdout().lock(), "{text}");
+            }
+            Ok(())
         }
     }
 }

@@ -12,6 +12,7 @@ pub mod polygons;
 pub mod prepare;
 pub mod read;
 pub mod soup;
+pub mod split;
 pub mod topology;
 pub mod validate;
 pub mod weld;

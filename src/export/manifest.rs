@@ -1,0 +1,220 @@
+//! `manifest.json`: the machine-readable record of a run (SPEC.md §5). Only facts
+//! that depend on the input and the options: no times, dates, hosts or absolute paths
+//! the user did not give. Lengths in millimetres, rounded to 4 decimals.
+
+use serde::Serialize;
+
+/// Rounds to 4 decimals (a tenth of a micron is far below any laser's precision) so the
+/// JSON is short and stable.
+pub fn round4(x: f64) -> f64 {
+    let r = (x * 1e4).round() / 1e4;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// The tool.
+#[derive(Clone, Debug, Serialize)]
+pub struct Tool {
+    /// "unfold".
+    pub name: &'static str,
+    /// Crate version.
+    pub version: &'static str,
+}
+
+/// The input model's facts (after preparation).
+#[derive(Clone, Debug, Serialize)]
+pub struct Input {
+    /// The model path as given.
+    pub path: String,
+    /// Vertices.
+    pub vertices: usize,
+    /// Edges.
+    pub edges: usize,
+    /// Faces.
+    pub faces: usize,
+    /// Boundary loops.
+    pub boundary_loops: usize,
+    /// Connected components.
+    pub components: usize,
+    /// Genus (sum over components).
+    pub genus: i64,
+    /// Faces split into triangles before building panels, by reason.
+    pub faces_split: FacesSplit,
+}
+
+/// Faces split before building panels.
+#[derive(Clone, Debug, Serialize)]
+pub struct FacesSplit {
+    /// Not planar within the tolerance.
+    pub non_planar: usize,
+    /// Not star-shaped from their centre.
+    pub not_star_shaped: usize,
+}
+
+/// Scheme name and parameters.
+#[derive(Clone, Debug, Serialize)]
+pub struct Scheme {
+    /// Scheme name.
+    pub name: String,
+    /// Parameters (lengths in mm).
+    pub params: SchemeParams,
+}
+
+/// Scheme parameters as used.
+#[derive(Clone, Debug, Serialize)]
+pub struct SchemeParams {
+    /// Face band scale.
+    pub face_scale: f64,
+    /// Connectors: "tab" or "none".
+    pub connectors: &'static str,
+    /// Wanted tab overlap (mm).
+    pub tab_height: f64,
+    /// Holes per connection.
+    pub holes: u32,
+    /// Hole diameter (mm).
+    pub hole_diameter: f64,
+    /// Wanted label cap height (mm).
+    pub label_height: f64,
+    /// Millimetres per model unit.
+    pub mm_per_model_unit: f64,
+}
+
+/// The sheet.
+#[derive(Clone, Debug, Serialize)]
+pub struct Sheet {
+    /// As given ("18x24in").
+    pub name: String,
+    /// Width (mm).
+    pub width: f64,
+    /// Height (mm).
+    pub height: f64,
+    /// Margin (mm).
+    pub margin: f64,
+    /// Spacing between parts (mm).
+    pub spacing: f64,
+    /// Kerf compensation applied (mm): 0 = nominal geometry.
+    pub kerf: f64,
+}
+
+/// Counts.
+#[derive(Clone, Debug, Serialize)]
+pub struct Counts {
+    /// Panels.
+    pub panels: usize,
+    /// Sheets.
+    pub sheets: usize,
+    /// ceil(total panel area / usable sheet area).
+    pub sheets_lower_bound: usize,
+    /// Holes in the files.
+    pub holes: usize,
+    /// Connections between panels.
+    pub connections: usize,
+    /// Woven cycles (0 for other schemes).
+    pub cycles: usize,
+    /// Labels left out because no legible size fits.
+    pub labels_left_out: usize,
+}
+
+/// Lengths of laser paths (mm).
+#[derive(Clone, Debug, Serialize)]
+pub struct Lengths {
+    /// Cut.
+    pub cut: f64,
+    /// Score.
+    pub score: f64,
+    /// Engrave.
+    pub engrave: f64,
+}
+
+/// One output sheet.
+#[derive(Clone, Debug, Serialize)]
+pub struct SheetEntry {
+    /// 1-based sheet number.
+    pub sheet: usize,
+    /// The SVG file name.
+    pub file: String,
+    /// Panels on it.
+    pub panels: usize,
+    /// Panel area / sheet area.
+    pub fill: f64,
+}
+
+/// Where a panel came from (`{"face": 12}`).
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum PanelSource {
+    /// A face.
+    Face {
+        /// Face index in the prepared mesh.
+        face: u32,
+        /// Face index in the input file.
+        input_face: u32,
+    },
+    /// An edge.
+    Edge {
+        /// Edge index.
+        edge: u32,
+    },
+    /// A woven cycle segment.
+    Cycle {
+        /// Cycle.
+        cycle: u32,
+        /// Segment.
+        segment: u32,
+    },
+}
+
+/// One panel.
+#[derive(Clone, Debug, Serialize)]
+pub struct PanelEntry {
+    /// Printed id.
+    pub id: String,
+    /// 1-based sheet number.
+    pub sheet: usize,
+    /// Area (mm²).
+    pub area: f64,
+    /// Provenance.
+    pub source: PanelSource,
+    /// Translation on the sheet (mm, origin lower-left, y up).
+    pub x: f64,
+    /// Translation on the sheet.
+    pub y: f64,
+    /// Rotation (degrees counter-clockwise).
+    pub rotation_deg: f64,
+    /// Mirrored (never, so far).
+    pub mirrored: bool,
+    /// Largest change of a facet edge length when unrolled (mm).
+    pub developability_error: f64,
+}
+
+/// The whole manifest.
+#[derive(Clone, Debug, Serialize)]
+pub struct Manifest {
+    /// Tool.
+    pub tool: Tool,
+    /// Input facts.
+    pub input: Input,
+    /// Scheme.
+    pub scheme: Scheme,
+    /// Always "mm".
+    pub units: &'static str,
+    /// Sheet.
+    pub sheet: Sheet,
+    /// Counts.
+    pub counts: Counts,
+    /// Total panel area (mm²).
+    pub panel_area: f64,
+    /// panel_area / (sheets × sheet area).
+    pub utilization: f64,
+    /// Laser path lengths.
+    pub lengths: Lengths,
+    /// Largest developability error of any panel (mm).
+    pub max_developability_error: f64,
+    /// The output sheets.
+    pub sheets: Vec<SheetEntry>,
+    /// Every panel.
+    pub panels: Vec<PanelEntry>,
+}

@@ -1,0 +1,242 @@
+//! Writing finished sheets. One routine ([`draw_sheet`]) walks a sheet in the order
+//! lasers want (engrave, score, cut; within cut, each part's holes and inner cuts before
+//! its outline) and feeds a [`SheetSink`]; the SVG and DXF writers are sinks, so both
+//! files carry exactly the same geometry.
+
+pub mod dxf;
+pub mod manifest;
+pub mod obj;
+pub mod svg;
+
+use glam::DVec2;
+
+use crate::font::text_strokes;
+use crate::nest::{Layout, Placement};
+use crate::panel::FlatPanel;
+
+/// The three kinds of laser geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Kind {
+    /// Marks: labels.
+    Engrave,
+    /// Partial depth: fold lines.
+    Score,
+    /// Through: outlines and holes.
+    Cut,
+}
+
+impl Kind {
+    /// Layer name.
+    pub fn layer(self) -> &'static str {
+        match self {
+            Kind::Engrave => "ENGRAVE",
+            Kind::Score => "SCORE",
+            Kind::Cut => "CUT",
+        }
+    }
+}
+
+/// Receives sheet geometry in sheet coordinates (mm, origin lower-left, y up).
+pub trait SheetSink {
+    /// A polyline; `closed` joins the last point to the first.
+    fn polyline(&mut self, kind: Kind, points: &[DVec2], closed: bool);
+    /// A circle.
+    fn circle(&mut self, kind: Kind, center: DVec2, radius: f64);
+}
+
+/// Lengths of what a sheet (or a run) draws, per kind (mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lengths {
+    /// Cut length.
+    pub cut: f64,
+    /// Score length.
+    pub score: f64,
+    /// Engrave length.
+    pub engrave: f64,
+}
+
+/// A sink that only measures.
+impl SheetSink for Lengths {
+    fn polyline(&mut self, kind: Kind, points: &[DVec2], closed: bool) {
+        let mut length: f64 = points.windows(2).map(|w| w[0].distance(w[1])).sum();
+        if closed && points.len() > 2 {
+            length += points[points.len() - 1].distance(points[0]);
+        }
+        *self.slot(kind) += length;
+    }
+    fn circle(&mut self, kind: Kind, _center: DVec2, radius: f64) {
+        *self.slot(kind) += std::f64::consts::TAU * radius;
+    }
+}
+
+impl Lengths {
+    fn slot(&mut self, kind: Kind) -> &mut f64 {
+        match kind {
+            Kind::Cut => &mut self.cut,
+            Kind::Score => &mut self.score,
+            Kind::Engrave => &mut self.engrave,
+        }
+    }
+}
+
+/// Draws sheet `index` of `layout` into `sink`.
+pub fn draw_sheet(layout: &Layout, index: usize, panels: &[FlatPanel], sink: &mut dyn SheetSink) {
+    let on_sheet: Vec<&Placement> = layout
+        .placements
+        .iter()
+        .filter(|p| p.sheet == index)
+        .collect();
+    for p in &on_sheet {
+        draw_labels(&panels[p.part], p, sink);
+    }
+    for p in &on_sheet {
+        let panel = &panels[p.part];
+        for &[a, b] in &panel.scores {
+            let line = [panel.points[a as usize], panel.points[b as usize]].map(|q| p.apply(q));
+            sink.polyline(Kind::Score, &line, false);
+        }
+    }
+    for p in &on_sheet {
+        let panel = &panels[p.part];
+        for hole in &panel.holes {
+            sink.circle(Kind::Cut, p.apply(hole.center), 0.5 * hole.diameter);
+        }
+        for lp in panel.outline.iter().skip(1) {
+            let points: Vec<DVec2> = lp
+                .iter()
+                .map(|&i| p.apply(panel.points[i as usize]))
+                .collect();
+            sink.polyline(Kind::Cut, &points, true);
+        }
+        let outer: Vec<DVec2> = panel.outline[0]
+            .iter()
+            .map(|&i| p.apply(panel.points[i as usize]))
+            .collect();
+        sink.polyline(Kind::Cut, &outer, true);
+    }
+}
+
+/// A label's strokes: scaled to its cap height, its box centred on the label centre,
+/// reading along its direction.
+fn draw_labels(panel: &FlatPanel, placement: &Placement, sink: &mut dyn SheetSink) {
+    for label in &panel.labels {
+        let strokes = text_strokes(&label.text);
+        let h = label.height;
+        // Read left to right on the sheet: turning the text half a turn about its box
+        // centre keeps it in the same box.
+        let mut d = placement.apply_direction(label.direction);
+        if d.x < -1e-9 || (d.x.abs() <= 1e-9 && d.y < 0.0) {
+            d = -d;
+        }
+        let up = d.perp();
+        let origin = placement.apply(label.center) - 0.5 * strokes.width * h * d - 0.5 * h * up;
+        for line in &strokes.polylines {
+            let points: Vec<DVec2> = line
+                .iter()
+                .map(|q| origin + q.x * h * d + q.y * h * up)
+                .collect();
+            sink.polyline(Kind::Engrave, &points, false);
+        }
+    }
+}
+
+/// Writes `files` into the folder `out` so that the folder is never half-written: the
+/// files go into a hidden sibling folder first, which then replaces `out` by renames.
+/// On any error the previous contents of `out` stay as they were.
+pub fn write_folder_atomically(
+    out: &std::path::Path,
+    files: &[(String, Vec<u8>)],
+) -> crate::Result<()> {
+    use crate::Error;
+    let fail = |what: &str, path: &std::path::Path, e: std::io::Error| {
+        Error::Runtime(format!(
+            "cannot {what} {}: {e} (choose a writable --out folder)",
+            path.display()
+        ))
+    };
+    let name = out
+        .file_name()
+        .ok_or_else(|| Error::Usage(format!("--out {}: not a folder name", out.display())))?
+        .to_string_lossy()
+        .into_owned();
+    let parent = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => std::path::PathBuf::from("."),
+    };
+    if out.exists() && !out.is_dir() {
+        return Err(Error::Runtime(format!(
+            "--out {} exists and is not a folder; remove it or choose another --out",
+            out.display()
+        )));
+    }
+    std::fs::create_dir_all(&parent).map_err(|e| fail("create", &parent, e))?;
+    let staging = parent.join(format!(".{name}.unfold-new"));
+    let previous = parent.join(format!(".{name}.unfold-old"));
+    for stale in [&staging, &previous] {
+        if stale.exists() {
+            std::fs::remove_dir_all(stale).map_err(|e| fail("remove", stale, e))?;
+        }
+    }
+    let write_all = || -> crate::Result<()> {
+        std::fs::create_dir(&staging).map_err(|e| fail("create", &staging, e))?;
+        for (file, bytes) in files {
+            let path = staging.join(file);
+            std::fs::write(&path, bytes).map_err(|e| fail("write", &path, e))?;
+        }
+        Ok(())
+    };
+    if let Err(e) = write_all() {
+        let _ = std::fs::remove_dir_all(&staging);
+        return Err(e);
+    }
+    let had_previous = out.exists();
+    if had_previous {
+        if let Err(e) = std::fs::rename(out, &previous) {
+            let _ = std::fs::remove_dir_all(&staging);
+            return Err(fail("replace", out, e));
+        }
+    }
+    if let Err(e) = std::fs::rename(&staging, out) {
+        if had_previous {
+            let _ = std::fs::rename(&previous, out);
+        }
+        let _ = std::fs::remove_dir_all(&staging);
+        return Err(fail("replace", out, e));
+    }
+    if had_previous {
+        let _ = std::fs::remove_dir_all(&previous);
+    }
+    Ok(())
+}
+
+/// A length in mm with at most 4 decimals, trailing zeros trimmed, never `-0`, never
+/// an exponent: identical input gives identical bytes.
+pub fn fmt_mm(x: f64) -> String {
+    let s = format!("{:.4}", x);
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_mm;
+
+    #[test]
+    fn numbers_are_fixed_and_trimmed() {
+        assert_eq!(fmt_mm(457.2), "457.2");
+        assert_eq!(fmt_mm(1.0 / 3.0), "0.3333");
+        assert_eq!(fmt_mm(-0.00001), "0");
+        assert_eq!(fmt_mm(12.0), "12");
+        assert_eq!(fmt_mm(1e-12), "0");
+        assert_eq!(fmt_mm(123456789.0), "123456789");
+        assert_eq!(fmt_mm(-2.50004), "-2.5");
+    }
+}

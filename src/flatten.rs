@@ -1,0 +1,283 @@
+//! Unrolling a 3D panel into the plane: breadth-first over its facets, each rotated
+//! about the hinge it shares with an already placed facet. The result is an isometry
+//! per facet, so holes and labels map both ways, and the developability error is the
+//! largest change of any facet edge length.
+
+use std::collections::{BTreeMap, VecDeque};
+
+use glam::{DVec2, DVec3};
+
+use crate::mesh::geometry::vector_area;
+use crate::panel::{signed_area, FacetFrame, FlatHole, FlatPanel, Panel};
+
+/// Why a panel cannot be unrolled (a bug in the scheme that made it).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FlattenError {
+    /// An edge shared by more than two facets.
+    #[error("panel {panel}: facet edge {a}-{b} is shared by more than two facets")]
+    NonManifold { panel: String, a: u32, b: u32 },
+    /// Facets that no hinge connects to the first.
+    #[error("panel {panel}: its facets are not connected by hinges")]
+    Disconnected { panel: String },
+    /// The cut edges do not close into loops.
+    #[error("panel {panel}: its outline does not close")]
+    OpenOutline { panel: String },
+    /// A facet with no area.
+    #[error("panel {panel}: facet {facet} has no area")]
+    DegenerateFacet { panel: String, facet: u32 },
+}
+
+/// Facet edges by their two vertices (smaller first): each use as (facet, from, to).
+type EdgeUses = BTreeMap<(u32, u32), Vec<(u32, u32, u32)>>;
+
+/// Fold angles below this (radians) are not scored: the two facets are coplanar.
+const FLAT_FOLD: f64 = 1e-9;
+
+/// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
+/// first edge along +x); every other facet is placed across a hinge.
+pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
+    let fail_id = || panel.id.clone();
+    let normals: Vec<DVec3> = panel
+        .facets
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let n = vector_area(f.iter().map(|&i| panel.vertices[i as usize]));
+            if n.length() > 0.0 {
+                Ok(n.normalize())
+            } else {
+                Err(FlattenError::DegenerateFacet {
+                    panel: fail_id(),
+                    facet: k as u32,
+                })
+            }
+        })
+        .collect::<Result<_, _>>()?;
+
+    // Edges: (min, max) -> the facets using it, with the direction each runs it.
+    let mut edges: EdgeUses = BTreeMap::new();
+    for (k, facet) in panel.facets.iter().enumerate() {
+        for i in 0..facet.len() {
+            let (a, b) = (facet[i], facet[(i + 1) % facet.len()]);
+            edges
+                .entry((a.min(b), a.max(b)))
+                .or_default()
+                .push((k as u32, a, b));
+        }
+    }
+    let mut hinges_of: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); panel.facets.len()];
+    let mut scores = Vec::new();
+    for (&(a, b), users) in &edges {
+        match users.as_slice() {
+            [_] => {}
+            [(f, _, _), (g, _, _)] => {
+                hinges_of[*f as usize].push((*g, a, b));
+                hinges_of[*g as usize].push((*f, a, b));
+                let fold = normals[*f as usize].angle_between(normals[*g as usize]);
+                if fold > FLAT_FOLD {
+                    scores.push([a, b]);
+                }
+            }
+            _ => {
+                return Err(FlattenError::NonManifold {
+                    panel: fail_id(),
+                    a,
+                    b,
+                })
+            }
+        }
+    }
+
+    let mut points = vec![DVec2::NAN; panel.vertices.len()];
+    let mut frames: Vec<Option<FacetFrame>> = vec![None; panel.facets.len()];
+    let mut queue = VecDeque::new();
+    if let Some(first) = panel.facets.first() {
+        let o = panel.vertices[first[0] as usize];
+        let x3 = (panel.vertices[first[1] as usize] - o).normalize();
+        frames[0] = Some(FacetFrame {
+            origin3: o,
+            x3,
+            y3: normals[0].cross(x3),
+            origin2: DVec2::ZERO,
+            x2: DVec2::X,
+        });
+        queue.push_back(0usize);
+    }
+    while let Some(f) = queue.pop_front() {
+        let frame = frames[f].expect("queued facets have frames");
+        for &i in &panel.facets[f] {
+            if points[i as usize].is_nan() {
+                points[i as usize] = frame.to_2d(panel.vertices[i as usize]);
+            }
+        }
+        for &(g, a, b) in &hinges_of[f] {
+            let g = g as usize;
+            if frames[g].is_some() {
+                continue;
+            }
+            // Rotate g about the hinge: its frame sits on the hinge, whose ends are
+            // already placed by f.
+            let (pa, pb) = (panel.vertices[a as usize], panel.vertices[b as usize]);
+            let x3 = (pb - pa).normalize();
+            let (qa, qb) = (points[a as usize], points[b as usize]);
+            frames[g] = Some(FacetFrame {
+                origin3: pa,
+                x3,
+                y3: normals[g].cross(x3),
+                origin2: qa,
+                x2: (qb - qa).normalize(),
+            });
+            queue.push_back(g);
+        }
+    }
+    let frames: Vec<FacetFrame> = frames
+        .into_iter()
+        .collect::<Option<_>>()
+        .ok_or_else(|| FlattenError::Disconnected { panel: fail_id() })?;
+
+    let mut developability_error = 0.0f64;
+    let mut area = 0.0;
+    for facet in &panel.facets {
+        let flat: Vec<DVec2> = facet.iter().map(|&i| points[i as usize]).collect();
+        area += signed_area(&flat);
+        for k in 0..facet.len() {
+            let (i, j) = (facet[k] as usize, facet[(k + 1) % facet.len()] as usize);
+            let d3 = panel.vertices[i].distance(panel.vertices[j]);
+            let d2 = points[i].distance(points[j]);
+            developability_error = developability_error.max((d3 - d2).abs());
+        }
+    }
+
+    let outline = outline_loops(&edges, &points)
+        .ok_or_else(|| FlattenError::OpenOutline { panel: fail_id() })?;
+    let holes = panel
+        .holes
+        .iter()
+        .map(|h| FlatHole {
+            center: frames[h.facet as usize].to_2d(h.position),
+            diameter: h.diameter,
+            connection: h.connection,
+            facet: h.facet,
+        })
+        .collect();
+    Ok(FlatPanel {
+        id: panel.id.clone(),
+        source: panel.source,
+        points,
+        facets: panel.facets.clone(),
+        frames,
+        outline,
+        scores,
+        holes,
+        wanted_labels: panel.labels.clone(),
+        labels: Vec::new(),
+        developability_error,
+        area,
+    })
+}
+
+/// Chains the edges used by one facet into loops, outer (largest area, counter-
+/// clockwise) first. `None` when they do not close or a corner has two ways on.
+fn outline_loops(edges: &EdgeUses, points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
+    let mut next_of: BTreeMap<u32, u32> = BTreeMap::new();
+    for users in edges.values() {
+        if let [(_, from, to)] = users.as_slice() {
+            if next_of.insert(*from, *to).is_some() {
+                return None;
+            }
+        }
+    }
+    let mut loops = Vec::new();
+    while let Some((&start, _)) = next_of.first_key_value() {
+        let mut lp = vec![start];
+        let mut at = next_of.remove(&start)?;
+        while at != start {
+            lp.push(at);
+            at = next_of.remove(&at)?;
+        }
+        loops.push(lp);
+    }
+    if loops.is_empty() {
+        return None;
+    }
+    // Outer loop first: the largest absolute area.
+    let areas: Vec<f64> = loops
+        .iter()
+        .map(|lp| signed_area(&lp.iter().map(|&i| points[i as usize]).collect::<Vec<_>>()))
+        .collect();
+    let outer = (0..loops.len())
+        .max_by(|&a, &b| areas[a].abs().total_cmp(&areas[b].abs()))
+        .unwrap_or(0);
+    loops.swap(0, outer);
+    Some(loops)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::panel::{Hole, Source};
+
+    /// A unit square facet and a second square folded up by 90° along x = 1, plus a
+    /// hole on the folded facet.
+    fn folded_strip() -> Panel {
+        Panel {
+            id: "T".into(),
+            source: Source::Face(0),
+            vertices: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(1.0, 0.0, 1.0),
+                DVec3::new(1.0, 1.0, 1.0),
+            ],
+            facets: vec![vec![0, 1, 2, 3], vec![1, 4, 5, 2]],
+            holes: vec![Hole {
+                position: DVec3::new(1.0, 0.5, 0.5),
+                diameter: 0.1,
+                connection: 7,
+                facet: 1,
+            }],
+            labels: vec![],
+        }
+    }
+
+    #[test]
+    fn folded_strip_unrolls_flat_and_keeps_lengths() {
+        let flat = flatten(&folded_strip()).unwrap();
+        assert!(flat.developability_error < 1e-12);
+        assert!((flat.area - 2.0).abs() < 1e-12);
+        // Unrolled, the fold at x = 1 opens to a 2 x 1 rectangle.
+        assert!(flat.points[4].distance(DVec2::new(2.0, 0.0)) < 1e-12);
+        assert!(flat.points[5].distance(DVec2::new(2.0, 1.0)) < 1e-12);
+        assert_eq!(flat.scores, vec![[1, 2]]);
+        assert_eq!(flat.outline.len(), 1);
+        assert_eq!(flat.outline[0].len(), 6);
+        assert!(signed_area(&flat.outer()) > 0.0, "outside face up");
+        // The hole maps into the plane and back to the same 3D point.
+        let hole = &flat.holes[0];
+        assert!(hole.center.distance(DVec2::new(1.5, 0.5)) < 1e-12);
+        let back = flat.frames[1].to_3d(hole.center);
+        assert!(back.distance(DVec3::new(1.0, 0.5, 0.5)) < 1e-12);
+    }
+
+    #[test]
+    fn coplanar_facets_are_not_scored() {
+        let mut panel = folded_strip();
+        panel.vertices[4] = DVec3::new(2.0, 0.0, 0.0);
+        panel.vertices[5] = DVec3::new(2.0, 1.0, 0.0);
+        panel.holes.clear();
+        let flat = flatten(&panel).unwrap();
+        assert!(flat.scores.is_empty());
+    }
+
+    #[test]
+    fn disconnected_facets_are_an_error() {
+        let mut panel = folded_strip();
+        panel.facets[1] = vec![4, 5, 3];
+        panel.vertices[3] = DVec3::new(5.0, 5.0, 0.0);
+        panel.facets[0] = vec![0, 1, 2];
+        panel.holes.clear();
+        assert!(flatten(&panel).is_err());
+    }
+}

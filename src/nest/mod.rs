@@ -1,0 +1,94 @@
+//! Placing flat panels on sheets. The nester sees only outlines (polygons in mm) and
+//! the sheet; it knows nothing of meshes or schemes.
+//!
+//! Coordinates on a sheet: millimetres, origin at the lower-left corner, y up (the
+//! exporters flip y for SVG).
+
+pub mod shelf;
+
+use glam::DVec2;
+
+/// The sheet and the clearances every layout must respect (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SheetSpec {
+    /// Width.
+    pub width: f64,
+    /// Height.
+    pub height: f64,
+    /// Empty border on every edge.
+    pub margin: f64,
+    /// Smallest gap between two parts.
+    pub spacing: f64,
+}
+
+impl SheetSpec {
+    /// Usable width inside the margins.
+    pub fn usable_width(&self) -> f64 {
+        self.width - 2.0 * self.margin
+    }
+
+    /// Usable height inside the margins.
+    pub fn usable_height(&self) -> f64 {
+        self.height - 2.0 * self.margin
+    }
+}
+
+/// Where one part goes: rotate about the part's origin, then translate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Placement {
+    /// Index of the part in the input list.
+    pub part: usize,
+    /// Sheet index (0-based).
+    pub sheet: usize,
+    /// Rotation, radians counter-clockwise.
+    pub rotation: f64,
+    /// Translation after rotation (mm).
+    pub translation: DVec2,
+}
+
+impl Placement {
+    /// A part point on the sheet.
+    pub fn apply(&self, p: DVec2) -> DVec2 {
+        DVec2::from_angle(self.rotation).rotate(p) + self.translation
+    }
+
+    /// A part direction on the sheet.
+    pub fn apply_direction(&self, d: DVec2) -> DVec2 {
+        DVec2::from_angle(self.rotation).rotate(d)
+    }
+}
+
+/// A finished layout: every part placed once.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    /// The sheet.
+    pub sheet: SheetSpec,
+    /// Number of sheets used.
+    pub sheets: usize,
+    /// One placement per part, in part order.
+    pub placements: Vec<Placement>,
+}
+
+/// A part too large for the sheet.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("part {part} is {width:.1} x {height:.1} mm at its most compact rotation and does not fit the usable {usable_width:.1} x {usable_height:.1} mm of the sheet")]
+pub struct TooLarge {
+    /// Index of the part.
+    pub part: usize,
+    /// Its smallest bounding box.
+    pub width: f64,
+    /// Its smallest bounding box.
+    pub height: f64,
+    /// The sheet's usable width.
+    pub usable_width: f64,
+    /// The sheet's usable height.
+    pub usable_height: f64,
+}
+
+/// Axis-aligned bounds of points.
+pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points.into_iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}

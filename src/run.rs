@@ -1,0 +1,364 @@
+//! The whole pipeline for one job: read → prepare → scale → split → scheme → flatten →
+//! labels → layout → export. Each stage is a call into its module; this file only
+//! composes them, times them and turns their failures into [`Error`]s.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use glam::DVec2;
+use rayon::prelude::*;
+
+use crate::config::{Job, NonPlanar};
+use crate::error::{Error, InputError, Result};
+use crate::export::manifest::{self, round4, Manifest};
+use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
+use crate::flatten::flatten;
+use crate::labels::{fit_labels, LabelOptions};
+use crate::mesh::split::{faces_to_split, split_faces};
+use crate::mesh::FaceId;
+use crate::nest::{shelf::shelf_layout, Layout, SheetSpec};
+use crate::panel::{FlatPanel, Source};
+use crate::plane::is_simple;
+use crate::scheme::build_panels;
+
+/// What a finished run produced.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// The manifest written to `manifest.json`.
+    pub manifest: Manifest,
+    /// File names written into the output folder, in order.
+    pub files: Vec<String>,
+    /// Observations for the report (repairs, shortened tabs, split faces…).
+    pub notes: Vec<String>,
+    /// Wall time per stage.
+    pub times: Vec<(&'static str, Duration)>,
+}
+
+struct Stopwatch {
+    last: Instant,
+    times: Vec<(&'static str, Duration)>,
+}
+
+impl Stopwatch {
+    fn new() -> Self {
+        Self {
+            last: Instant::now(),
+            times: Vec::new(),
+        }
+    }
+
+    fn lap(&mut self, stage: &'static str) {
+        let now = Instant::now();
+        self.times.push((stage, now - self.last));
+        self.last = now;
+    }
+}
+
+/// Runs a job and writes its output folder (atomically: on any error the folder is
+/// left as it was).
+pub fn run(job: &Job) -> Result<Outcome> {
+    let mut clock = Stopwatch::new();
+    let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
+    let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
+    let mut mesh = prepared.mesh;
+    clock.lap("read");
+
+    let geometry = mesh.geometry_facts(job.model.planarity_tol);
+    let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
+    mesh.scale(mm_per_unit);
+    let split = faces_to_split(&mesh, job.model.planarity_tol);
+    if job.nonplanar == NonPlanar::Error && !split.non_planar.is_empty() {
+        let worst = FaceId(split.non_planar[0]);
+        let source = mesh.face_source(worst) as usize;
+        return Err(InputError::new(
+            &job.model_path,
+            raw.face_location(source),
+            format!(
+                "{} faces are not planar within --planarity-tol {} (first: face {source})",
+                split.non_planar.len(),
+                job.model.planarity_tol
+            ),
+            "use --nonplanar triangulate, raise --planarity-tol, or flatten the faces in your modeller",
+        )
+        .into());
+    }
+    if !split.non_planar.is_empty() {
+        notes.push(format!(
+            "{} non-planar faces were split into triangles (planarity tolerance {})",
+            split.non_planar.len(),
+            job.model.planarity_tol
+        ));
+    }
+    if !split.not_star_shaped.is_empty() {
+        notes.push(format!(
+            "{} concave faces were split into triangles: their centre does not see every edge, so bands and tabs would leave the face",
+            split.not_star_shaped.len()
+        ));
+    }
+    if split.count() > 0 {
+        mesh = split_faces(&mesh, &split)
+            .map_err(|e| Error::Runtime(format!("splitting faces failed: {e}")))?;
+    }
+    let topology = mesh.topology();
+    clock.lap("prepare");
+
+    let output = build_panels(job.scheme, &mesh, &job.scheme_options)
+        .map_err(|e| Error::Usage(e.to_string()))?;
+    notes.extend(output.notes.iter().cloned());
+    clock.lap("scheme");
+
+    let mut flat: Vec<FlatPanel> = output
+        .panels
+        .par_iter()
+        .map(flatten)
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
+    if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
+        return Err(Error::Runtime(format!(
+            "panel {} overlaps itself when unrolled; try a smaller --tab-height",
+            bad.id
+        )));
+    }
+    let labels_left_out: usize = flat
+        .par_iter_mut()
+        .map(|p| fit_labels(p, LabelOptions::default()))
+        .sum();
+    clock.lap("flatten");
+
+    let sheet = SheetSpec {
+        width: job.sheet.width,
+        height: job.sheet.height,
+        margin: job.margin,
+        spacing: job.spacing,
+    };
+    let outlines: Vec<Vec<DVec2>> = flat.iter().map(|p| p.outer()).collect();
+    let layout = shelf_layout(&outlines, sheet, job.rotations).map_err(|e| {
+        Error::Runtime(format!(
+            "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
+            flat[e.part].id, e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
+        ))
+    })?;
+    clock.lap("nest");
+
+    let name = job
+        .model_path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".into());
+    let digits = layout.sheets.to_string().len().max(2);
+    let mut files: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut lengths = Lengths::default();
+    let mut sheet_entries = Vec::new();
+    for index in 0..layout.sheets {
+        let stem = format!("{name}-{:0digits$}", index + 1);
+        if job.formats.svg {
+            let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, svg::SvgStyle::default());
+            draw_sheet(&layout, index, &flat, &mut sink);
+            files.push((format!("{stem}.svg"), sink.finish().into_bytes()));
+        }
+        if job.formats.dxf {
+            let mut sink = DxfSheet::new(sheet.width, sheet.height);
+            draw_sheet(&layout, index, &flat, &mut sink);
+            files.push((format!("{stem}.dxf"), sink.finish().into_bytes()));
+        }
+        draw_sheet(&layout, index, &flat, &mut lengths);
+        let on_sheet: Vec<&FlatPanel> = layout
+            .placements
+            .iter()
+            .filter(|p| p.sheet == index)
+            .map(|p| &flat[p.part])
+            .collect();
+        let area: f64 = on_sheet.iter().map(|p| p.area).sum();
+        sheet_entries.push(manifest::SheetEntry {
+            sheet: index + 1,
+            file: format!("{stem}.svg"),
+            panels: on_sheet.len(),
+            fill: round4(area / (sheet.width * sheet.height)),
+        });
+    }
+    let manifest = build_manifest(
+        job,
+        &mesh,
+        &topology,
+        &split,
+        mm_per_unit,
+        &output,
+        &flat,
+        &layout,
+        lengths,
+        labels_left_out,
+        sheet_entries,
+    );
+    let json = serde_json::to_string_pretty(&manifest)
+        .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
+    files.push(("manifest.json".into(), (json + "\n").into_bytes()));
+    files.push((
+        format!("{name}-assembled.obj"),
+        assembled_obj(&output.panels).into_bytes(),
+    ));
+    crate::export::write_folder_atomically(&job.out, &files)?;
+    clock.lap("export");
+
+    Ok(Outcome {
+        manifest,
+        files: files.into_iter().map(|(n, _)| n).collect(),
+        notes,
+        times: clock.times,
+    })
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_manifest(
+    job: &Job,
+    mesh: &crate::mesh::Mesh,
+    topology: &crate::mesh::Topology,
+    split: &crate::mesh::split::SplitReport,
+    mm_per_unit: f64,
+    output: &crate::scheme::SchemeOutput,
+    flat: &[FlatPanel],
+    layout: &Layout,
+    lengths: Lengths,
+    labels_left_out: usize,
+    sheets: Vec<manifest::SheetEntry>,
+) -> Manifest {
+    let o = &job.scheme_options;
+    let sheet = &layout.sheet;
+    let panel_area: f64 = flat.iter().map(|p| p.area).sum();
+    let usable = sheet.usable_width() * sheet.usable_height();
+    let lower_bound = (panel_area / usable).ceil() as usize;
+    let panels = flat
+        .iter()
+        .zip(&layout.placements)
+        .map(|(p, placement)| manifest::PanelEntry {
+            id: p.id.clone(),
+            sheet: placement.sheet + 1,
+            area: round4(p.area),
+            source: match p.source {
+                Source::Face(f) => manifest::PanelSource::Face {
+                    face: f,
+                    input_face: mesh.face_source(FaceId(f)),
+                },
+                Source::Edge(e) => manifest::PanelSource::Edge { edge: e },
+                Source::Cycle { cycle, segment } => manifest::PanelSource::Cycle { cycle, segment },
+            },
+            x: round4(placement.translation.x),
+            y: round4(placement.translation.y),
+            rotation_deg: round4(placement.rotation.to_degrees()),
+            mirrored: false,
+            developability_error: p.developability_error,
+        })
+        .collect();
+    Manifest {
+        tool: manifest::Tool {
+            name: "unfold",
+            version: env!("CARGO_PKG_VERSION"),
+        },
+        input: manifest::Input {
+            path: job.model_path.display().to_string(),
+            vertices: topology.vertices,
+            edges: topology.edges,
+            faces: topology.faces,
+            boundary_loops: topology.boundary_loops,
+            components: topology.components.len(),
+            genus: topology.genus,
+            faces_split: manifest::FacesSplit {
+                non_planar: split.non_planar.len(),
+                not_star_shaped: split.not_star_shaped.len(),
+            },
+        },
+        scheme: manifest::Scheme {
+            name: job.scheme.to_string(),
+            params: manifest::SchemeParams {
+                face_scale: o.face_scale,
+                connectors: if o.tabs { "tab" } else { "none" },
+                tab_height: round4(o.tab_height),
+                holes: o.holes,
+                hole_diameter: round4(o.hole_diameter),
+                label_height: round4(o.label_height),
+                mm_per_model_unit: mm_per_unit,
+            },
+        },
+        units: "mm",
+        sheet: manifest::Sheet {
+            name: job.sheet.name.clone(),
+            width: round4(sheet.width),
+            height: round4(sheet.height),
+            margin: round4(sheet.margin),
+            spacing: round4(sheet.spacing),
+            kerf: 0.0,
+        },
+        counts: manifest::Counts {
+            panels: flat.len(),
+            sheets: layout.sheets,
+            sheets_lower_bound: lower_bound,
+            holes: flat.iter().map(|p| p.holes.len()).sum(),
+            connections: output.connections,
+            cycles: 0,
+            labels_left_out,
+        },
+        panel_area: round4(panel_area),
+        utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
+        lengths: manifest::Lengths {
+            cut: round4(lengths.cut),
+            score: round4(lengths.score),
+            engrave: round4(lengths.engrave),
+        },
+        max_developability_error: flat
+            .iter()
+            .map(|p| p.developability_error)
+            .fold(0.0, f64::max),
+        sheets,
+        panels,
+    }
+}
+
+/// The short report printed on stderr.
+pub fn report_text(outcome: &Outcome, out: &Path) -> String {
+    use std::fmt::Write;
+    let m = &outcome.manifest;
+    let c = &m.counts;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: {} scheme, {} panels, {} connections, {} holes",
+        m.input.path, m.scheme.name, c.panels, c.connections, c.holes
+    );
+    let _ = writeln!(
+        s,
+        "sheets: {} of {} ({:.1} x {:.1} mm); area lower bound {}; utilization {:.1}%",
+        c.sheets,
+        m.sheet.name,
+        m.sheet.width,
+        m.sheet.height,
+        c.sheets_lower_bound,
+        100.0 * m.utilization
+    );
+    let _ = writeln!(
+        s,
+        "lengths: cut {:.0} mm, score {:.0} mm, engrave {:.0} mm; max developability error {:.1e} mm",
+        m.lengths.cut, m.lengths.score, m.lengths.engrave, m.max_developability_error
+    );
+    if c.labels_left_out > 0 {
+        let _ = writeln!(
+            s,
+            "labels: {} left out (no room for a 1.5 mm cap height)",
+            c.labels_left_out
+        );
+    }
+    for note in &outcome.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    let times: Vec<String> = outcome
+        .times
+        .iter()
+        .map(|(stage, t)| format!("{stage} {:.0} ms", t.as_secs_f64() * 1e3))
+        .collect();
+    let _ = writeln!(s, "time: {}", times.join(", "));
+    let _ = writeln!(
+        s,
+        "wrote {} files to {} (DXF in millimetres)",
+        outcome.files.len(),
+        out.display()
+    );
+    s
+}

@@ -1,0 +1,350 @@
+//! The half-edge scheme: one panel per face (its face band), and on every interior edge
+//! a tab on one of the two panels that folds along the edge onto the neighbour.
+//!
+//! The tab lies in the neighbour's plane, inside the triangle (edge, neighbour centre):
+//! those triangles tile a star-shaped face, so tabs arriving on one face never overlap
+//! each other and never leave it. Its sides lean in at 45° (so tabs of one panel do not
+//! meet when unrolled around a corner); where the triangle is lower than the wanted
+//! height the tab is shortened. With a face scale `s < 1` the panels are smaller than
+//! the faces and the tab first spans the gap in its own face's plane (a bridge facet).
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use super::{face_band, SchemeOptions, SchemeOutput};
+use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
+use crate::panel::{Hole, Label, LabelKind, Panel, Source};
+use crate::plane::{area, clip_convex, distance_to_border};
+
+/// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
+/// outline, plus the fastener holes through it and the neighbour.
+#[derive(Clone, Debug)]
+struct Tab {
+    /// Owner half-edge (a → b in the owner face).
+    owner: HalfEdgeId,
+    /// Base points on the edge: a' near a, b' near b.
+    base: [DVec3; 2],
+    /// The tab outline after b', a' (so the tab facet is b', a', top…).
+    top: Vec<DVec3>,
+    /// Hole centres (in the neighbour's plane).
+    holes: Vec<DVec3>,
+    /// The tab is lower than wanted.
+    shortened: bool,
+    /// Holes were wanted but do not fit.
+    holes_skipped: bool,
+}
+
+/// The id printed for a face panel.
+pub fn panel_id(f: FaceId) -> String {
+    format!("F{}", f.0)
+}
+
+/// Builds the face panels of a mesh whose faces are planar and star-shaped from their
+/// centres (the split stage ensures both).
+pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
+    let s = options.face_scale;
+    let bands: Vec<Vec<DVec3>> = mesh.faces().map(|f| face_band(mesh, f, s)).collect();
+
+    // Tabs per edge (interior edges only), computed independently in parallel and
+    // collected in edge order.
+    let tabs: Vec<Option<Tab>> = (0..mesh.edge_count() as u32)
+        .into_par_iter()
+        .map(|e| {
+            let e = EdgeId(e);
+            if !options.tabs || mesh.is_boundary_edge(e) {
+                return None;
+            }
+            // The owner alternates with the edge index: even edges give the tab to the
+            // face of half-edge 2e, odd edges to the face of 2e + 1.
+            let owner = if e.0 % 2 == 0 {
+                e.half_edge()
+            } else {
+                e.half_edge().twin()
+            };
+            make_tab(mesh, owner, &bands, options)
+        })
+        .collect();
+
+    let connections = tabs.iter().flatten().count();
+    let mut notes = Vec::new();
+    let interior = mesh.edges().filter(|&e| !mesh.is_boundary_edge(e)).count();
+    if options.tabs && connections < interior {
+        notes.push(format!(
+            "{} interior edges have no tab: their neighbour face is too small to hold one",
+            interior - connections
+        ));
+    }
+    let shortened = tabs.iter().flatten().filter(|t| t.shortened).count();
+    if shortened > 0 {
+        notes.push(format!(
+            "{shortened} tabs were shortened to stay inside their neighbour face"
+        ));
+    }
+    let skipped = tabs.iter().flatten().filter(|t| t.holes_skipped).count();
+    if skipped > 0 {
+        notes.push(format!(
+            "{skipped} connections have no fastener holes: the tab is too small for a {} mm hole",
+            options.hole_diameter
+        ));
+    }
+
+    let panels = (0..mesh.face_count() as u32)
+        .into_par_iter()
+        .map(|f| face_panel(mesh, FaceId(f), &bands[f as usize], &tabs, options))
+        .collect();
+    SchemeOutput {
+        panels,
+        connections,
+        notes,
+    }
+}
+
+/// Builds the panel of face `f`.
+fn face_panel(
+    mesh: &Mesh,
+    f: FaceId,
+    band: &[DVec3],
+    tabs: &[Option<Tab>],
+    options: &SchemeOptions,
+) -> Panel {
+    let s = options.face_scale;
+    let mut vertices: Vec<DVec3> = band.to_vec();
+    let add = |p: DVec3, vertices: &mut Vec<DVec3>| {
+        vertices.push(p);
+        (vertices.len() - 1) as u32
+    };
+    let half_edges: Vec<HalfEdgeId> = mesh.face_half_edges(f).collect();
+    let n = half_edges.len();
+    let mut band_facet: Vec<u32> = Vec::with_capacity(n + 4);
+    let mut extra_facets: Vec<Vec<u32>> = Vec::new();
+    let mut holes = Vec::new();
+    let mut labels = Vec::new();
+    // Facet 0 is the band; tab facets follow (indices known once pushed).
+    let tab_of = |h: HalfEdgeId| tabs[h.edge().index()].as_ref();
+    let mut pending_tabs: Vec<(&Tab, u32, u32)> = Vec::new();
+    for (k, &h) in half_edges.iter().enumerate() {
+        band_facet.push(k as u32);
+        let Some(tab) = tab_of(h).filter(|t| t.owner == h) else {
+            continue;
+        };
+        let a_base = add(tab.base[0], &mut vertices);
+        let b_base = add(tab.base[1], &mut vertices);
+        if s >= 1.0 {
+            // The tab hinges on the face edge itself.
+            band_facet.push(a_base);
+            band_facet.push(b_base);
+        } else {
+            // Bridge across the gap in the face's own plane: band edge → mesh edge.
+            let a = add(mesh.position(mesh.origin(h)), &mut vertices);
+            let b = add(mesh.position(mesh.dest(h)), &mut vertices);
+            let (ka, kb) = (k as u32, ((k + 1) % n) as u32);
+            extra_facets.push(vec![kb, ka, a, a_base, b_base, b]);
+        }
+        pending_tabs.push((tab, a_base, b_base));
+    }
+    let mut facets = vec![band_facet];
+    facets.extend(extra_facets);
+    for (tab, a_base, b_base) in pending_tabs {
+        let mut facet = vec![b_base, a_base];
+        for &p in &tab.top {
+            facet.push(add(p, &mut vertices));
+        }
+        let facet_index = facets.len() as u32;
+        facets.push(facet);
+        for &p in &tab.holes {
+            holes.push(Hole {
+                position: p,
+                diameter: options.hole_diameter,
+                connection: tab.owner.edge().0,
+                facet: facet_index,
+            });
+        }
+    }
+    // Holes of tabs other panels fold onto this face go through the band.
+    for &h in &half_edges {
+        if let Some(tab) = tab_of(h).filter(|t| t.owner != h) {
+            for &p in &tab.holes {
+                holes.push(Hole {
+                    position: p,
+                    diameter: options.hole_diameter,
+                    connection: tab.owner.edge().0,
+                    facet: 0,
+                });
+            }
+        }
+    }
+
+    // Labels: the panel id at the centre, along the longest band edge; the partner id
+    // inside every interior edge.
+    let longest = (0..n)
+        .max_by(|&i, &j| {
+            let li = band[i].distance(band[(i + 1) % n]);
+            let lj = band[j].distance(band[(j + 1) % n]);
+            li.total_cmp(&lj).then(j.cmp(&i))
+        })
+        .unwrap_or(0);
+    let centre = band.iter().copied().sum::<DVec3>() / n as f64;
+    labels.push(Label {
+        text: panel_id(f),
+        anchor: centre,
+        direction: (band[(longest + 1) % n] - band[longest]).normalize(),
+        height: options.label_height,
+        facet: 0,
+        kind: LabelKind::Panel,
+        on_edge: false,
+    });
+    for (k, &h) in half_edges.iter().enumerate() {
+        let Some(g) = mesh.face(h.twin()) else {
+            continue;
+        };
+        if options.tabs && tab_of(h).is_none() {
+            continue;
+        }
+        let (a, b) = (band[k], band[(k + 1) % n]);
+        labels.push(Label {
+            text: panel_id(g),
+            anchor: 0.5 * (a + b),
+            direction: (b - a).normalize(),
+            height: options.label_height,
+            facet: 0,
+            kind: LabelKind::Partner,
+            on_edge: true,
+        });
+    }
+
+    Panel {
+        id: panel_id(f),
+        source: Source::Face(f.0),
+        vertices,
+        facets,
+        holes,
+        labels,
+    }
+}
+
+/// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
+/// `None` when the neighbour cannot hold one.
+fn make_tab(
+    mesh: &Mesh,
+    owner: HalfEdgeId,
+    bands: &[Vec<DVec3>],
+    options: &SchemeOptions,
+) -> Option<Tab> {
+    let g = mesh.face(owner.twin())?;
+    let (a, b) = (
+        mesh.position(mesh.origin(owner)),
+        mesh.position(mesh.dest(owner)),
+    );
+    let length = a.distance(b);
+    let x = (b - a) / length;
+    let n_g = mesh.face_normal(g);
+    // Inward direction of the neighbour at this edge, in its plane.
+    let y = x.cross(n_g).normalize();
+    let to2 = |p: DVec3| DVec2::new((p - a).dot(x), (p - a).dot(y));
+    let to3 = |q: DVec2| a + q.x * x + q.y * y;
+    let centre = to2(mesh.face_centre(g));
+    if centre.y <= 0.0 {
+        return None;
+    }
+    let s = options.face_scale;
+    let gap = (1.0 - s) * centre.y;
+    let wanted = gap + options.tab_height;
+    // Inset the base a little from the corners so tabs from neighbouring edges that
+    // arrive on the same face do not touch.
+    let inset = (0.05 * length).min(0.5);
+    let (lo, hi) = (inset, length - inset);
+    let trapezoid = if hi - lo > 2.0 * wanted {
+        vec![
+            DVec2::new(lo, 0.0),
+            DVec2::new(hi, 0.0),
+            DVec2::new(hi - wanted, wanted),
+            DVec2::new(lo + wanted, wanted),
+        ]
+    } else {
+        let h = 0.5 * (hi - lo);
+        vec![
+            DVec2::new(lo, 0.0),
+            DVec2::new(hi, 0.0),
+            DVec2::new(0.5 * (lo + hi), h),
+        ]
+    };
+    let sector = [DVec2::ZERO, DVec2::new(length, 0.0), centre];
+    let tab = clip_convex(&trapezoid, &sector);
+    let top_height = tab.iter().map(|q| q.y).fold(0.0, f64::max);
+    let overlap = top_height - gap;
+    if tab.len() < 3 || area(&tab) <= 0.0 || overlap < (0.5 * options.tab_height).min(1.0) {
+        return None;
+    }
+    // The tab facet runs b', a', then the rest: the clipped polygon is
+    // counter-clockwise in (x, y) starting at a' = (lo, 0), b' = (hi, 0).
+    let start = tab
+        .iter()
+        .position(|q| q.distance(DVec2::new(lo, 0.0)) < 1e-9)?;
+    let ccw: Vec<DVec2> = (0..tab.len())
+        .map(|k| tab[(start + k) % tab.len()])
+        .collect();
+    if ccw[1].distance(DVec2::new(hi, 0.0)) > 1e-9 {
+        return None;
+    }
+    let top: Vec<DVec3> = ccw[2..].iter().rev().map(|&q| to3(q)).collect();
+
+    let (holes, holes_skipped) =
+        place_holes(&ccw, gap, top_height, &bands[g.index()], &to2, options);
+    Some(Tab {
+        owner,
+        base: [to3(DVec2::new(lo, 0.0)), to3(DVec2::new(hi, 0.0))],
+        top,
+        holes: holes.into_iter().map(to3).collect(),
+        shortened: top_height < wanted - 1e-9,
+        holes_skipped,
+    })
+}
+
+/// Hole centres along the middle of the tab's overlap with the neighbour band, each
+/// at least one radius of material away from the tab's and the band's outline.
+fn place_holes(
+    tab: &[DVec2],
+    gap: f64,
+    top_height: f64,
+    neighbour_band: &[DVec3],
+    to2: &dyn Fn(DVec3) -> DVec2,
+    options: &SchemeOptions,
+) -> (Vec<DVec2>, bool) {
+    let count = options.holes;
+    if count == 0 {
+        return (Vec::new(), false);
+    }
+    let r = 0.5 * options.hole_diameter;
+    let clearance = 2.0 * r;
+    let v = 0.5 * (gap + top_height);
+    // The tab's extent at height v (it is convex: two crossings).
+    let mut xs = Vec::new();
+    for i in 0..tab.len() {
+        let (p, q) = (tab[i], tab[(i + 1) % tab.len()]);
+        if (p.y - v) * (q.y - v) <= 0.0 && p.y != q.y {
+            xs.push(p.x + (v - p.y) / (q.y - p.y) * (q.x - p.x));
+        }
+    }
+    let (Some(u0), Some(u1)) = (
+        xs.iter().copied().reduce(f64::min),
+        xs.iter().copied().reduce(f64::max),
+    ) else {
+        return (Vec::new(), true);
+    };
+    let band: Vec<DVec2> = neighbour_band.iter().map(|&p| to2(p)).collect();
+    let centres: Vec<DVec2> = (1..=count)
+        .map(|k| DVec2::new(u0 + (u1 - u0) * k as f64 / (count + 1) as f64, v))
+        .collect();
+    let fits = centres.iter().all(|&c| {
+        distance_to_border(tab, c) >= clearance
+            && crate::plane::contains(&band, c)
+            && distance_to_border(&band, c) >= clearance
+    }) && centres
+        .windows(2)
+        .all(|w| w[0].distance(w[1]) >= 2.0 * clearance);
+    if fits {
+        (centres, false)
+    } else {
+        (Vec::new(), true)
+    }
+}

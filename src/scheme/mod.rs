@@ -1,0 +1,69 @@
+//! Panel schemes: each takes a read-only mesh (in millimetres) and its options and
+//! returns 3D panels with provenance. A scheme knows nothing of sheets or files.
+//!
+//! Adding a scheme: one file here and one arm in [`build_panels`].
+
+pub mod half_edge;
+
+use glam::DVec3;
+
+use crate::config::SchemeName;
+use crate::mesh::{FaceId, Mesh};
+use crate::panel::Panel;
+
+/// Options shared by the schemes (lengths in mm, fractions as fractions).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SchemeOptions {
+    /// Face band scale `s`: corners move toward the face centre, `s·v + (1−s)·c`.
+    pub face_scale: f64,
+    /// Tabs on interior edges (half-edge scheme).
+    pub tabs: bool,
+    /// Wanted height of a tab's overlap with its neighbour (mm).
+    pub tab_height: f64,
+    /// Fastener holes per connection.
+    pub holes: u32,
+    /// Hole diameter (mm).
+    pub hole_diameter: f64,
+    /// Wanted label cap height (mm).
+    pub label_height: f64,
+}
+
+/// What a scheme produced.
+#[derive(Clone, Debug, Default)]
+pub struct SchemeOutput {
+    /// The panels, in a deterministic order.
+    pub panels: Vec<Panel>,
+    /// Number of connections (links between two panels).
+    pub connections: usize,
+    /// Observations for the report (tabs shortened or left out, holes skipped).
+    pub notes: Vec<String>,
+}
+
+/// Errors a scheme reports (options it cannot honour).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SchemeError {
+    /// The scheme exists in the command line but not yet in the tool.
+    #[error("the {0} scheme is not implemented yet; use --scheme half-edge")]
+    NotImplemented(SchemeName),
+}
+
+/// Runs the named scheme.
+pub fn build_panels(
+    name: SchemeName,
+    mesh: &Mesh,
+    options: &SchemeOptions,
+) -> Result<SchemeOutput, SchemeError> {
+    match name {
+        SchemeName::HalfEdge => Ok(half_edge::panels(mesh, options)),
+        other => Err(SchemeError::NotImplemented(other)),
+    }
+}
+
+/// The face band of a face: each corner moved toward the face centre,
+/// `s·v + (1−s)·c` (thesis: "face centre" = average of the corners).
+pub fn face_band(mesh: &Mesh, f: FaceId, s: f64) -> Vec<DVec3> {
+    let c = mesh.face_centre(f);
+    mesh.face_positions(f)
+        .map(|v| s * v + (1.0 - s) * c)
+        .collect()
+}
