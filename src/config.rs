@@ -303,7 +303,7 @@ impl ModelOptions {
 #[derive(Clone, Debug, Default, Deserialize, clap::Args)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct BuildOptions {
-    /// Panel scheme. [default: quad-edge]
+    /// Panel scheme (half-edge is the one built so far). [default: half-edge]
     #[arg(long, value_name = "SCHEME")]
     pub scheme: Option<SchemeName>,
 
@@ -365,6 +365,11 @@ pub struct BuildOptions {
     #[arg(long, value_name = "N")]
     pub rotations: Option<u32>,
 
+    /// Stroke width in the SVG files, with a unit. Laser drivers treat only hairlines
+    /// as vector lines; a wider stroke is for previews. [default: 0.001in]
+    #[arg(long, value_name = "LENGTH")]
+    pub stroke_width: Option<String>,
+
     #[command(flatten)]
     #[serde(flatten)]
     pub model: ModelOptions,
@@ -424,6 +429,8 @@ pub struct Job {
     pub nonplanar: NonPlanar,
     /// Rotation steps for the layout.
     pub rotations: u32,
+    /// SVG stroke width (mm).
+    pub stroke_width: f64,
 }
 
 impl BuildOptions {
@@ -444,6 +451,7 @@ impl BuildOptions {
             label_height: self.label_height.or(other.label_height),
             nonplanar: self.nonplanar.or(other.nonplanar),
             rotations: self.rotations.or(other.rotations),
+            stroke_width: self.stroke_width.or(other.stroke_width),
             model: self.model.or(other.model),
         }
     }
@@ -524,9 +532,10 @@ impl BuildOptions {
             scheme_options,
             nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
             rotations,
+            stroke_width: length("stroke-width", &self.stroke_width, "0.001in")?,
             model_path: model_path.to_path_buf(),
             model: self.model.resolve()?,
-            scheme: self.scheme.unwrap_or(SchemeName::QuadEdge),
+            scheme: self.scheme.unwrap_or(SchemeName::HalfEdge),
             sheet,
             margin,
             spacing,

@@ -65,18 +65,29 @@ pub fn fit_labels(panel: &mut FlatPanel, options: LabelOptions) -> usize {
         let text_width = text_strokes(&wanted.text).width;
         let mut height = wanted.height;
         let mut fitted = None;
-        while height >= options.min_height {
-            let center = if wanted.on_edge {
-                // Twice the margin off the edge: the fit test wants at least one margin,
-                // and rounding must not make an exact margin fail at every size.
-                anchor + (2.0 * options.margin + 0.5 * height) * direction.perp()
-            } else {
-                anchor
-            };
-            let bx = label_box(center, direction, text_width * height, height);
-            if box_fits(&bx, &facet, panel, &placed, options.margin) {
-                fitted = Some((center, bx));
-                break;
+        // Positions along the reading direction, nearest the anchor first.
+        let slides: Vec<f64> = if wanted.slide > 0.0 {
+            [0.0, -0.5, 0.5, -1.0, 1.0]
+                .iter()
+                .map(|f| f * wanted.slide)
+                .collect()
+        } else {
+            vec![0.0]
+        };
+        'sizes: while height >= options.min_height {
+            for &shift in &slides {
+                let mut center = anchor + shift * direction;
+                if wanted.on_edge {
+                    // Twice the margin off the edge: the fit test wants at least one
+                    // margin, and rounding must not make an exact margin fail every
+                    // size.
+                    center += (2.0 * options.margin + 0.5 * height) * direction.perp();
+                }
+                let bx = label_box(center, direction, text_width * height, height);
+                if box_fits(&bx, &facet, panel, &placed, options.margin) {
+                    fitted = Some((center, bx));
+                    break 'sizes;
+                }
             }
             height *= SHRINK;
         }

@@ -68,6 +68,9 @@ pub struct Label {
     pub kind: LabelKind,
     /// Anchored on an edge (see the type's doc).
     pub on_edge: bool,
+    /// How far (mm) the anchor may slide along `direction` either way to find room
+    /// (0: fixed).
+    pub slide: f64,
 }
 
 /// A panel in 3D, as it sits in the assembled model (millimetres).

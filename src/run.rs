@@ -152,7 +152,11 @@ pub fn run(job: &Job) -> Result<Outcome> {
     for index in 0..layout.sheets {
         let stem = format!("{name}-{:0digits$}", index + 1);
         if job.formats.svg {
-            let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, svg::SvgStyle::default());
+            let style = svg::SvgStyle {
+                stroke_width: job.stroke_width,
+                ..svg::SvgStyle::default()
+            };
+            let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
             draw_sheet(&layout, index, &flat, &mut sink);
             files.push((format!("{stem}.svg"), sink.finish().into_bytes()));
         }
@@ -354,11 +358,13 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         .map(|(stage, t)| format!("{stage} {:.0} ms", t.as_secs_f64() * 1e3))
         .collect();
     let _ = writeln!(s, "time: {}", times.join(", "));
+    let dxf = outcome.files.iter().any(|f| f.ends_with(".dxf"));
     let _ = writeln!(
         s,
-        "wrote {} files to {} (DXF in millimetres)",
+        "wrote {} files to {}{}",
         outcome.files.len(),
-        out.display()
+        out.display(),
+        if dxf { " (DXF in millimetres)" } else { "" }
     );
     s
 }

@@ -192,6 +192,7 @@ fn face_panel(
         facet: 0,
         kind: LabelKind::Panel,
         on_edge: false,
+        slide: 0.0,
     });
     for (k, &h) in half_edges.iter().enumerate() {
         let Some(g) = mesh.face(h.twin()) else {
@@ -209,6 +210,8 @@ fn face_panel(
             facet: 0,
             kind: LabelKind::Partner,
             on_edge: true,
+            // Room to dodge the holes of a tab arriving on this edge.
+            slide: 0.3 * a.distance(b),
         });
     }
 

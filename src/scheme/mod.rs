@@ -43,7 +43,7 @@ pub struct SchemeOutput {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SchemeError {
     /// The scheme exists in the command line but not yet in the tool.
-    #[error("the {0} scheme is not implemented yet; use --scheme half-edge")]
+    #[error("the {0} scheme is not implemented yet in this version; use --scheme half-edge")]
     NotImplemented(SchemeName),
 }
 
