@@ -34,6 +34,13 @@ pub struct Outcome {
     pub times: Vec<(&'static str, Duration)>,
 }
 
+/// One sheet's files, path lengths and manifest entry.
+struct DrawnSheet {
+    files: Vec<(String, Vec<u8>)>,
+    lengths: Lengths,
+    entry: manifest::SheetEntry,
+}
+
 struct Stopwatch {
     last: Instant,
     times: Vec<(&'static str, Duration)>,
@@ -146,39 +153,58 @@ pub fn run(job: &Job) -> Result<Outcome> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "model".into());
     let digits = layout.sheets.to_string().len().max(2);
+    // Sheets are independent: drawn in parallel, collected in sheet order.
+    let drawn: Vec<DrawnSheet> = (0..layout.sheets)
+        .into_par_iter()
+        .map(|index| {
+            let stem = format!("{name}-{:0digits$}", index + 1);
+            let mut sheet_files = Vec::new();
+            if job.formats.svg {
+                let style = svg::SvgStyle {
+                    stroke_width: job.stroke_width,
+                    ..svg::SvgStyle::default()
+                };
+                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
+                draw_sheet(&layout, index, &flat, &mut sink);
+                sheet_files.push((format!("{stem}.svg"), sink.finish().into_bytes()));
+            }
+            if job.formats.dxf {
+                let mut sink = DxfSheet::new(sheet.width, sheet.height);
+                draw_sheet(&layout, index, &flat, &mut sink);
+                sheet_files.push((format!("{stem}.dxf"), sink.finish().into_bytes()));
+            }
+            let mut lengths = Lengths::default();
+            draw_sheet(&layout, index, &flat, &mut lengths);
+            let on_sheet: Vec<&FlatPanel> = layout
+                .placements
+                .iter()
+                .filter(|p| p.sheet == index)
+                .map(|p| &flat[p.part])
+                .collect();
+            let area: f64 = on_sheet.iter().map(|p| p.area).sum();
+            let entry = manifest::SheetEntry {
+                sheet: index + 1,
+                file: format!("{stem}.svg"),
+                panels: on_sheet.len(),
+                fill: round4(area / (sheet.width * sheet.height)),
+            };
+            DrawnSheet {
+                files: sheet_files,
+                lengths,
+                entry,
+            }
+        })
+        .collect();
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut lengths = Lengths::default();
     let mut sheet_entries = Vec::new();
-    for index in 0..layout.sheets {
-        let stem = format!("{name}-{:0digits$}", index + 1);
-        if job.formats.svg {
-            let style = svg::SvgStyle {
-                stroke_width: job.stroke_width,
-                ..svg::SvgStyle::default()
-            };
-            let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
-            draw_sheet(&layout, index, &flat, &mut sink);
-            files.push((format!("{stem}.svg"), sink.finish().into_bytes()));
-        }
-        if job.formats.dxf {
-            let mut sink = DxfSheet::new(sheet.width, sheet.height);
-            draw_sheet(&layout, index, &flat, &mut sink);
-            files.push((format!("{stem}.dxf"), sink.finish().into_bytes()));
-        }
-        draw_sheet(&layout, index, &flat, &mut lengths);
-        let on_sheet: Vec<&FlatPanel> = layout
-            .placements
-            .iter()
-            .filter(|p| p.sheet == index)
-            .map(|p| &flat[p.part])
-            .collect();
-        let area: f64 = on_sheet.iter().map(|p| p.area).sum();
-        sheet_entries.push(manifest::SheetEntry {
-            sheet: index + 1,
-            file: format!("{stem}.svg"),
-            panels: on_sheet.len(),
-            fill: round4(area / (sheet.width * sheet.height)),
-        });
+    for sheet in drawn {
+        files.extend(sheet.files);
+        // Summed in sheet order, so the totals do not depend on the thread count.
+        lengths.cut += sheet.lengths.cut;
+        lengths.score += sheet.lengths.score;
+        lengths.engrave += sheet.lengths.engrave;
+        sheet_entries.push(sheet.entry);
     }
     let manifest = build_manifest(
         job,
