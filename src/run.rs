@@ -68,7 +68,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
     let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
     let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
     let mut mesh = prepared.mesh;
-    clock.lap("read");
+    clock.lap("load");
 
     let geometry = mesh.geometry_facts(job.model.planarity_tol);
     let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
@@ -107,7 +107,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
             .map_err(|e| Error::Runtime(format!("splitting faces failed: {e}")))?;
     }
     let topology = mesh.topology();
-    clock.lap("prepare");
+    clock.lap("split");
 
     let output = build_panels(job.scheme, &mesh, &job.scheme_options)
         .map_err(|e| Error::Usage(e.to_string()))?;
