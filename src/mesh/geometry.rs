@@ -21,6 +21,15 @@ pub fn vector_area(corners: impl IntoIterator<Item = DVec3>) -> DVec3 {
     0.5 * sum
 }
 
+/// The axis-aligned bounding box of points: (lower corner, upper corner). Empty input
+/// gives (+∞, −∞).
+pub fn bounding_box(points: impl IntoIterator<Item = DVec3>) -> (DVec3, DVec3) {
+    points.into_iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
 /// The least-squares plane through points: (centroid, unit normal). The normal is the
 /// eigenvector of the covariance matrix with the smallest eigenvalue, oriented to agree
 /// with the polygon's vector area so it points outward for a face.
@@ -48,10 +57,7 @@ pub fn best_fit_plane(points: &[DVec3]) -> (DVec3, DVec3) {
 /// polygon with thousands of corners costs O(n), not O(n²).
 pub fn diameter(points: &[DVec3]) -> f64 {
     if points.len() > 64 {
-        let (lo, hi) = points.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        );
+        let (lo, hi) = bounding_box(points.iter().copied());
         return (hi - lo).length();
     }
     let mut best = 0.0f64;

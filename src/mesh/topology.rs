@@ -3,7 +3,6 @@
 
 use std::collections::BTreeMap;
 
-use glam::DVec3;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -209,10 +208,7 @@ impl Mesh {
 
     /// Area, bounding box and planarity, with faces above `planarity_tolerance` counted.
     pub fn geometry_facts(&self, planarity_tolerance: f64) -> GeometryFacts {
-        let (lo, hi) = self.positions.iter().fold(
-            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        );
+        let (lo, hi) = super::geometry::bounding_box(self.positions.iter().copied());
         let errors = self.face_planarity_errors();
         let (least_planar_face, max_planarity_error) =
             errors

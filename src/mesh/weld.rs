@@ -15,10 +15,7 @@ use super::soup::{fan_counts, CornerEdges};
 /// diagonal. Single-precision files repeat a shared vertex bit for bit, and double
 /// precision files agree far closer than this; real features are far larger.
 pub fn weld_tolerance(points: &[DVec3]) -> f64 {
-    let (lo, hi) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
+    let (lo, hi) = super::geometry::bounding_box(points.iter().copied());
     let diagonal = (hi - lo).length();
     if diagonal.is_finite() {
         diagonal * 1e-7
@@ -39,10 +36,7 @@ pub fn cluster_positions(points: &[DVec3], tolerance: f64) -> Vec<u32> {
     if points.is_empty() {
         return parent;
     }
-    let (lo, hi) = points.iter().fold(
-        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    );
+    let (lo, hi) = super::geometry::bounding_box(points.iter().copied());
     let diagonal = (hi - lo).length();
     if diagonal.is_nan() || diagonal <= 0.0 {
         // Every point at one position (or none finite): one cluster.
