@@ -91,9 +91,13 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
     let mut points = vec![DVec2::NAN; panel.vertices.len()];
     let mut frames: Vec<Option<FacetFrame>> = vec![None; panel.facets.len()];
     let mut queue = VecDeque::new();
+    // The x axis of a frame is the facet edge projected into the facet's plane, so the
+    // frame is orthonormal even for a facet that is only nearly planar, and
+    // `to_3d(to_2d(p))` is the projection of p onto the facet's plane.
+    let in_plane = |e: DVec3, n: DVec3| (e - e.dot(n) * n).normalize();
     if let Some(first) = panel.facets.first() {
         let o = panel.vertices[first[0] as usize];
-        let x3 = (panel.vertices[first[1] as usize] - o).normalize();
+        let x3 = in_plane(panel.vertices[first[1] as usize] - o, normals[0]);
         frames[0] = Some(FacetFrame {
             origin3: o,
             x3,
@@ -118,7 +122,7 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
             // Rotate g about the hinge: its frame sits on the hinge, whose ends are
             // already placed by f.
             let (pa, pb) = (panel.vertices[a as usize], panel.vertices[b as usize]);
-            let x3 = (pb - pa).normalize();
+            let x3 = in_plane(pb - pa, normals[g]);
             let (qa, qb) = (points[a as usize], points[b as usize]);
             frames[g] = Some(FacetFrame {
                 origin3: pa,

@@ -275,7 +275,7 @@ fn build_manifest(
             y: round4(placement.translation.y),
             rotation_deg: round4(placement.rotation.to_degrees()),
             mirrored: false,
-            developability_error: p.developability_error,
+            developability_error: manifest::round_nm(p.developability_error),
         })
         .collect();
     Manifest {
@@ -333,10 +333,11 @@ fn build_manifest(
             score: round4(lengths.score),
             engrave: round4(lengths.engrave),
         },
-        max_developability_error: flat
-            .iter()
-            .map(|p| p.developability_error)
-            .fold(0.0, f64::max),
+        max_developability_error: manifest::round_nm(
+            flat.iter()
+                .map(|p| p.developability_error)
+                .fold(0.0, f64::max),
+        ),
         sheets,
         panels,
     }

@@ -15,6 +15,17 @@ pub fn round4(x: f64) -> f64 {
     }
 }
 
+/// Rounds to the nanometre: developability errors of exact panels are float noise
+/// (1e-14 mm) that would change with the last bit of a sine; real errors stay visible.
+pub fn round_nm(x: f64) -> f64 {
+    let r = (x * 1e6).round() / 1e6;
+    if r == 0.0 {
+        0.0
+    } else {
+        r
+    }
+}
+
 /// The tool.
 #[derive(Clone, Debug, Serialize)]
 pub struct Tool {

@@ -122,6 +122,10 @@ fn face_panel(
     // Facet 0 is the band; tab facets follow (indices known once pushed).
     let tab_of = |h: HalfEdgeId| tabs[h.edge().index()].as_ref();
     let mut pending_tabs: Vec<(&Tab, u32, u32)> = Vec::new();
+    // With s < 1, the mesh corners where bridges meet: one vertex per corner, shared by
+    // the bridges on both sides so that their common side is a (flat) hinge, not a
+    // cut running there and back.
+    let mut mesh_corner: Vec<Option<u32>> = vec![None; n];
     for (k, &h) in half_edges.iter().enumerate() {
         band_facet.push(k as u32);
         let Some(tab) = tab_of(h).filter(|t| t.owner == h) else {
@@ -135,8 +139,12 @@ fn face_panel(
             band_facet.push(b_base);
         } else {
             // Bridge across the gap in the face's own plane: band edge → mesh edge.
-            let a = add(mesh.position(mesh.origin(h)), &mut vertices);
-            let b = add(mesh.position(mesh.dest(h)), &mut vertices);
+            let mut corner = |i: usize, vertices: &mut Vec<DVec3>| {
+                *mesh_corner[i]
+                    .get_or_insert_with(|| add(mesh.position(mesh.origin(half_edges[i])), vertices))
+            };
+            let a = corner(k, &mut vertices);
+            let b = corner((k + 1) % n, &mut vertices);
             let (ka, kb) = (k as u32, ((k + 1) % n) as u32);
             extra_facets.push(vec![kb, ka, a, a_base, b_base, b]);
         }
