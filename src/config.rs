@@ -330,9 +330,29 @@ pub struct BuildOptions {
     pub format: Option<String>,
 
     /// Face band scale s: each panel corner moves toward the face centre,
-    /// s·v + (1−s)·c. [default: 1.0 for half-edge]
+    /// s·v + (1−s)·c. [default: 1 for half-edge, 0.5 for quad-edge]
     #[arg(long, value_name = "S")]
     pub face_scale: Option<f64>,
+
+    /// Edge band control points (quad-edge): b·v + (1−b)·m toward the edge midpoint m;
+    /// smaller b makes the bend rounder. [default: 0.5]
+    #[arg(long, value_name = "B")]
+    pub bridge_scale: Option<f64>,
+
+    /// Flap depth (quad-edge): the flap's inner line joins the band corners moved this
+    /// fraction toward the face centre. [default: 0.5]
+    #[arg(long, value_name = "F")]
+    pub flap_scale: Option<f64>,
+
+    /// Strips of the Bézier bend (quad-edge); every ruling between two strips is a
+    /// score line. [default: 4]
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
+
+    /// Winged-edge wings: 0 = a half-length wing on each side, 1 = one full-length
+    /// wing over the next edge's flap, -1 = over the previous edge's. [default: 0]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    pub shift: Option<i32>,
 
     /// Connectors on interior edges (half-edge scheme): tab or none. [default: tab]
     #[arg(long, value_name = "KIND")]
@@ -343,7 +363,8 @@ pub struct BuildOptions {
     #[arg(long, value_name = "LENGTH")]
     pub tab_height: Option<String>,
 
-    /// Fastener holes per connection (half-edge: 0, 1 or 2). [default: 0 for half-edge]
+    /// Fastener holes per connection: half-edge 0, 1 or 2; quad-edge 0, 1, 2 or 4.
+    /// [default: 0 for half-edge, 2 for quad-edge]
     #[arg(long, value_name = "N")]
     pub holes: Option<u32>,
 
@@ -444,6 +465,10 @@ impl BuildOptions {
             out: self.out.or(other.out),
             format: self.format.or(other.format),
             face_scale: self.face_scale.or(other.face_scale),
+            bridge_scale: self.bridge_scale.or(other.bridge_scale),
+            flap_scale: self.flap_scale.or(other.flap_scale),
+            samples: self.samples.or(other.samples),
+            shift: self.shift.or(other.shift),
             connectors: self.connectors.or(other.connectors),
             tab_height: self.tab_height.or(other.tab_height),
             holes: self.holes.or(other.holes),
@@ -499,18 +524,48 @@ impl BuildOptions {
                 Err(usage(option, format!("'{text}' must be positive")))
             }
         };
-        let face_scale = self.face_scale.unwrap_or(1.0);
-        if !(face_scale > 0.0 && face_scale <= 1.0) {
+        let scheme = self.scheme.unwrap_or(SchemeName::HalfEdge);
+        let fraction = |option: &str, value: Option<f64>, default: f64| {
+            let x = value.unwrap_or(default);
+            if x > 0.0 && x <= 1.0 {
+                Ok(x)
+            } else {
+                Err(usage(
+                    option,
+                    format!("{x} must be greater than 0 and at most 1"),
+                ))
+            }
+        };
+        let face_scale = fraction(
+            "face-scale",
+            self.face_scale,
+            if scheme == SchemeName::HalfEdge {
+                1.0
+            } else {
+                0.5
+            },
+        )?;
+        let bridge_scale = fraction("bridge-scale", self.bridge_scale, 0.5)?;
+        let flap_scale = fraction("flap-scale", self.flap_scale, 0.5)?;
+        let samples = self.samples.unwrap_or(4);
+        if !(1..=64).contains(&samples) {
             return Err(usage(
-                "face-scale",
-                format!("{face_scale} must be greater than 0 and at most 1"),
+                "samples",
+                format!("{samples} must be between 1 and 64"),
             ));
         }
-        let holes = self.holes.unwrap_or(0);
-        if holes > 2 {
+        let shift = self.shift.unwrap_or(0);
+        if !(-1..=1).contains(&shift) {
+            return Err(usage("shift", format!("{shift} must be -1, 0 or 1")));
+        }
+        let (holes, allowed): (u32, &[u32]) = match scheme {
+            SchemeName::HalfEdge => (self.holes.unwrap_or(0), &[0, 1, 2]),
+            _ => (self.holes.unwrap_or(2), &[0, 1, 2, 4]),
+        };
+        if !allowed.contains(&holes) {
             return Err(usage(
                 "holes",
-                format!("{holes} holes per connection; the half-edge scheme takes 0, 1 or 2"),
+                format!("{holes} holes per connection; the {scheme} scheme takes {allowed:?}"),
             ));
         }
         let rotations = self.rotations.unwrap_or(32);
@@ -522,6 +577,10 @@ impl BuildOptions {
         }
         let scheme_options = crate::scheme::SchemeOptions {
             face_scale,
+            bridge_scale,
+            flap_scale,
+            samples,
+            shift,
             tabs: self.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
             tab_height: length("tab-height", &self.tab_height, "8mm")?,
             holes,
@@ -535,7 +594,7 @@ impl BuildOptions {
             stroke_width: length("stroke-width", &self.stroke_width, "0.001in")?,
             model_path: model_path.to_path_buf(),
             model: self.model.resolve()?,
-            scheme: self.scheme.unwrap_or(SchemeName::HalfEdge),
+            scheme,
             sheet,
             margin,
             spacing,

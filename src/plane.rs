@@ -3,6 +3,24 @@
 
 use glam::DVec2;
 
+/// Keeps the part of a convex polygon on the left of the directed line a → b (the
+/// line itself included). Points of the polygon on the kept side stay exact.
+pub fn clip_half_plane(poly: &[DVec2], a: DVec2, b: DVec2) -> Vec<DVec2> {
+    let side = |p: DVec2| (b - a).perp_dot(p - a);
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for j in 0..poly.len() {
+        let (p, q) = (poly[j], poly[(j + 1) % poly.len()]);
+        let (dp, dq) = (side(p), side(q));
+        if dp >= 0.0 {
+            out.push(p);
+        }
+        if (dp >= 0.0) != (dq >= 0.0) {
+            out.push(p + dp / (dp - dq) * (q - p));
+        }
+    }
+    out
+}
+
 /// Clips a polygon by a convex counter-clockwise polygon (Sutherland–Hodgman). The
 /// result is the intersection, counter-clockwise when the subject is; points of the
 /// subject inside (or on the border of) the clip polygon are kept exactly.
@@ -12,22 +30,7 @@ pub fn clip_convex(subject: &[DVec2], clip: &[DVec2]) -> Vec<DVec2> {
         if out.is_empty() {
             break;
         }
-        let (a, b) = (clip[i], clip[(i + 1) % clip.len()]);
-        let inside = |p: DVec2| (b - a).perp_dot(p - a) >= 0.0;
-        let input = std::mem::take(&mut out);
-        for j in 0..input.len() {
-            let (p, q) = (input[j], input[(j + 1) % input.len()]);
-            let (pin, qin) = (inside(p), inside(q));
-            if pin {
-                out.push(p);
-            }
-            if pin != qin {
-                let dp = (b - a).perp_dot(p - a);
-                let dq = (b - a).perp_dot(q - a);
-                let t = dp / (dp - dq);
-                out.push(p + t * (q - p));
-            }
-        }
+        out = clip_half_plane(&out, clip[i], clip[(i + 1) % clip.len()]);
     }
     out
 }

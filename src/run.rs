@@ -73,7 +73,11 @@ pub fn run(job: &Job) -> Result<Outcome> {
     let geometry = mesh.geometry_facts(job.model.planarity_tol);
     let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
     mesh.scale(mm_per_unit);
-    let split = faces_to_split(&mesh, job.model.planarity_tol);
+    let split = faces_to_split(
+        &mesh,
+        job.model.planarity_tol,
+        crate::scheme::needs_convex_faces(job.scheme),
+    );
     if job.nonplanar == NonPlanar::Error && !split.non_planar.is_empty() {
         let worst = FaceId(split.non_planar[0]);
         let source = mesh.face_source(worst) as usize;
@@ -98,7 +102,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
     }
     if !split.not_star_shaped.is_empty() {
         notes.push(format!(
-            "{} concave faces were split into triangles: their centre does not see every edge, so bands and tabs would leave the face",
+            "{} concave faces were split into triangles: the scheme's bands, tabs or flaps would leave them",
             split.not_star_shaped.len()
         ));
     }

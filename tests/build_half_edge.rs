@@ -16,177 +16,29 @@ mod common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::OsStr;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 
 use glam::{DVec2, DVec3};
 use serde_json::Value;
 use tempfile::TempDir;
 
-use common::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
-use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
-use unfold::flatten::flatten;
-use unfold::mesh::split::{faces_to_split, split_faces};
-use unfold::mesh::{EdgeId, Mesh};
-use unfold::panel::{FlatPanel, LabelKind, Panel, Source};
-use unfold::scheme::build_panels;
+use common::build::{
+    check_output, check_sheets, close, compare_with_golden, count, crate_dir, distance_to_border,
+    entry_names, finish, folder_files, inside, inspect_json, model, num, obj_face_count, panels_of,
+    read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck, Golden,
+};
+use unfold::config::{Job, SchemeName};
+use unfold::mesh::EdgeId;
+use unfold::panel::{LabelKind, Source};
 
 // =======================================================================================
-// Helpers
+// Helpers (the shared ones are in tests/common/build.rs)
 // =======================================================================================
-
-fn crate_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// A model of the project's own `models/` folder.
-fn model(name: &str) -> PathBuf {
-    crate_dir().join("models").join(format!("{name}.obj"))
-}
-
-/// The shared models folder, or `None` (with a message) when this checkout has none.
-fn shared_models(test: &str) -> Option<PathBuf> {
-    let dir = crate_dir().join("../shared/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!(
-            "{test}: skipping the shared models: {} is absent",
-            dir.display()
-        );
-        None
-    }
-}
-
-/// What one run of the binary did.
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-fn unfold_command() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_unfold"))
-}
-
-fn finish(cmd: &mut Command) -> Run {
-    let output = cmd.output().expect("the unfold binary runs");
-    Run {
-        code: output.status.code(),
-        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
-    }
-}
-
-fn unfold<I, S>(args: I) -> Run
-where
-    I: IntoIterator<Item = S>,
-    S: AsRef<OsStr>,
-{
-    finish(unfold_command().args(args))
-}
 
 /// Runs `unfold MODEL --scheme half-edge --size SIZE --out OUT EXTRA…`, asserts success
 /// and returns the parsed `manifest.json`.
 fn build(model: &Path, size: &str, out: &Path, extra: &[&str]) -> Value {
-    let mut args: Vec<&OsStr> = vec![
-        model.as_os_str(),
-        OsStr::new("--scheme"),
-        OsStr::new("half-edge"),
-        OsStr::new("--size"),
-        OsStr::new(size),
-        OsStr::new("--out"),
-        out.as_os_str(),
-    ];
-    args.extend(extra.iter().map(OsStr::new));
-    let run = unfold(&args);
-    assert_eq!(run.code, Some(0), "unfold {args:?} failed:\n{}", run.stderr);
-    read_manifest(out)
-}
-
-fn read_manifest(out: &Path) -> Value {
-    let text = std::fs::read_to_string(out.join("manifest.json"))
-        .unwrap_or_else(|e| panic!("{}/manifest.json: {e}", out.display()));
-    serde_json::from_str(&text).expect("manifest.json is JSON")
-}
-
-/// The value at a dotted path, as a number (panics naming the key otherwise).
-fn num(v: &Value, path: &str) -> f64 {
-    let mut cur = v;
-    for key in path.split('.') {
-        cur = &cur[key];
-    }
-    cur.as_f64()
-        .unwrap_or_else(|| panic!("{path} is not a number: {cur}"))
-}
-
-fn count(v: &Value, path: &str) -> usize {
-    let mut cur = v;
-    for key in path.split('.') {
-        cur = &cur[key];
-    }
-    cur.as_u64()
-        .unwrap_or_else(|| panic!("{path} is not a count: {cur}")) as usize
-}
-
-/// Every file of a folder (no subfolders expected) with its bytes, by name.
-fn folder_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    let mut files = BTreeMap::new();
-    for entry in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
-        let entry = entry.unwrap();
-        assert!(
-            entry.file_type().unwrap().is_file(),
-            "{} is not a plain file",
-            entry.path().display()
-        );
-        let name = entry.file_name().to_string_lossy().into_owned();
-        files.insert(name, std::fs::read(entry.path()).unwrap());
-    }
-    files
-}
-
-/// Names of the entries of a folder.
-fn entry_names(dir: &Path) -> BTreeSet<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect()
-}
-
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
-}
-
-/// Faces of an OBJ file as written (`f` statements), counted without the tool.
-fn obj_face_count(path: &Path) -> usize {
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .filter(|l| l.trim_start().starts_with("f "))
-        .count()
-}
-
-/// Positions and faces (0-based) of a simple OBJ file (`v x y z`, `f a b c…` with
-/// optional `/…` suffixes and positive indices), read without the tool.
-fn read_simple_obj(path: &Path) -> (Vec<DVec3>, Vec<Vec<usize>>) {
-    let mut positions = Vec::new();
-    let mut faces = Vec::new();
-    for line in std::fs::read_to_string(path).unwrap().lines() {
-        let mut words = line.split_whitespace();
-        match words.next() {
-            Some("v") => {
-                let c: Vec<f64> = words.take(3).map(|w| w.parse().unwrap()).collect();
-                positions.push(DVec3::new(c[0], c[1], c[2]));
-            }
-            Some("f") => faces.push(
-                words
-                    .map(|w| w.split('/').next().unwrap().parse::<usize>().unwrap() - 1)
-                    .collect(),
-            ),
-            _ => {}
-        }
-    }
-    (positions, faces)
+    common::build::build("half-edge", model, size, out, extra)
 }
 
 /// Area of a planar 3D polygon (Newell's vector area).
@@ -199,171 +51,8 @@ fn polygon_area_3d(points: &[DVec3]) -> f64 {
         * 0.5
 }
 
-/// Even-odd point in polygon, written here rather than taken from `unfold::plane`.
-fn inside(poly: &[DVec2], p: DVec2) -> bool {
-    let mut inside = false;
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
-            inside = !inside;
-        }
-    }
-    inside
-}
-
-fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
-    (0..poly.len())
-        .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-            p.distance(a + t * (b - a))
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
-fn sheet_spec(manifest: &Value) -> SheetSpec {
-    SheetSpec {
-        width: num(manifest, "sheet.width"),
-        height: num(manifest, "sheet.height"),
-        margin: num(manifest, "sheet.margin"),
-        spacing: num(manifest, "sheet.spacing"),
-    }
-}
-
-/// Which DXF files of a folder to run through ezdxf.
-#[derive(Clone, Copy, PartialEq)]
-enum DxfCheck {
-    /// Every one.
-    All,
-    /// The first and the last sheet (every one with `UNFOLD_FULL_DXF=1`).
-    FirstAndLast,
-}
-
-/// The sheets of an output folder after the independent check.
-struct Sheets {
-    /// SVG file names, in order.
-    svg_files: Vec<String>,
-    /// Stats of every SVG sheet, in the same order.
-    stats: Vec<SheetStats>,
-}
-
-impl Sheets {
-    fn total(&self) -> SheetStats {
-        let mut t = SheetStats::default();
-        for s in &self.stats {
-            t.panels += s.panels;
-            t.holes += s.holes;
-            t.cut_paths += s.cut_paths;
-            t.score_paths += s.score_paths;
-            t.engrave_paths += s.engrave_paths;
-            t.panel_area += s.panel_area;
-            t.cut_length += s.cut_length;
-            t.score_length += s.score_length;
-            t.engrave_length += s.engrave_length;
-        }
-        t
-    }
-}
-
-/// Checks every SVG of `out` with `check_svg_sheet` (sheet spec from the manifest) and
-/// the DXF files chosen by `dxf` with `check_dxf_matches_svg` against their SVG.
-fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
-    let spec = sheet_spec(manifest);
-    let names = entry_names(out);
-    let svg_files: Vec<String> = names
-        .iter()
-        .filter(|n| n.ends_with(".svg"))
-        .cloned()
-        .collect();
-    let dxf_files: Vec<String> = names
-        .iter()
-        .filter(|n| n.ends_with(".dxf"))
-        .cloned()
-        .collect();
-    let mut stats = Vec::new();
-    for name in &svg_files {
-        let text = std::fs::read_to_string(out.join(name)).unwrap();
-        let s = check_svg_sheet(&text, &spec)
-            .unwrap_or_else(|e| panic!("{}: sheet check failed:\n{e}", out.join(name).display()));
-        stats.push(s);
-    }
-    for name in &dxf_files {
-        let svg = name.trim_end_matches(".dxf").to_string() + ".svg";
-        assert!(svg_files.contains(&svg), "{name} has no SVG twin");
-    }
-    let full = std::env::var("UNFOLD_FULL_DXF").is_ok_and(|v| v == "1");
-    let chosen: Vec<&String> = if dxf == DxfCheck::All || full || dxf_files.len() <= 2 {
-        dxf_files.iter().collect()
-    } else {
-        vec![&dxf_files[0], &dxf_files[dxf_files.len() - 1]]
-    };
-    // ezdxf runs in child processes: check a few at once.
-    let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
-    let chunk = chosen.len().div_ceil(workers).max(1);
-    let failures: Vec<String> = std::thread::scope(|scope| {
-        let handles: Vec<_> = chosen
-            .chunks(chunk)
-            .map(|names| {
-                scope.spawn(move || {
-                    names
-                        .iter()
-                        .filter_map(|name| {
-                            let svg_name = name.trim_end_matches(".dxf").to_string() + ".svg";
-                            let svg = std::fs::read_to_string(out.join(svg_name)).unwrap();
-                            check_dxf_matches_svg(&out.join(name), &svg, spec.height).err()
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
-            .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().expect("DXF check thread"))
-            .collect()
-    });
-    assert!(
-        failures.is_empty(),
-        "{} DXF files fail:\n{}",
-        failures.len(),
-        failures.join("\n")
-    );
-    Sheets { svg_files, stats }
-}
-
-/// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
-/// scheme, flatten. Returns the mesh the scheme used, the 3D and the flat panels.
-fn panels_of(job: &Job) -> (Mesh, usize, Vec<Panel>, Vec<FlatPanel>) {
-    let (_raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
-    let mut mesh = prepared.mesh;
-    let geometry = mesh.geometry_facts(job.model.planarity_tol);
-    let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
-    mesh.scale(mm_per_unit);
-    let split = faces_to_split(&mesh, job.model.planarity_tol);
-    if split.count() > 0 {
-        mesh = split_faces(&mesh, &split).expect("split faces");
-    }
-    let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
-    let flat = output
-        .panels
-        .iter()
-        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id)))
-        .collect();
-    (mesh, output.connections, output.panels, flat)
-}
-
 fn half_edge_job(model: &Path, size: &str, holes: u32, out: &Path) -> Job {
-    BuildOptions {
-        scheme: Some(SchemeName::HalfEdge),
-        holes: Some(holes),
-        out: Some(out.to_path_buf()),
-        model: ModelOptions {
-            size: Some(size.to_string()),
-            ..Default::default()
-        },
-        ..Default::default()
-    }
-    .resolve(model)
-    .expect("options resolve")
+    common::build::job(SchemeName::HalfEdge, model, size, holes, out)
 }
 
 // =======================================================================================
@@ -382,25 +71,13 @@ fn check_build(model: &Path, size: &str, dxf: DxfCheck) {
         &out,
         &["--sheet", "18x24in", "--format", "svg,dxf"],
     );
-    let name = model.file_stem().unwrap().to_string_lossy().into_owned();
-    let panels = count(&m, "counts.panels");
-    let sheets = count(&m, "counts.sheets");
-    assert!(sheets >= 1, "{what}: no sheets");
-
-    // The files: one SVG and one DXF per sheet, the manifest and the assembled model.
-    let digits = sheets.to_string().len().max(2);
-    let mut expected =
-        BTreeSet::from(["manifest.json".to_string(), format!("{name}-assembled.obj")]);
-    for k in 1..=sheets {
-        expected.insert(format!("{name}-{k:0digits$}.svg"));
-        expected.insert(format!("{name}-{k:0digits$}.dxf"));
-    }
-    assert_eq!(entry_names(&out), expected, "{what}: output files");
-
-    let checked = check_sheets(&out, &m, dxf);
-    let total = checked.total();
+    // Files, sheets against the manifest, panel list (ids F<face>), layout figures.
+    check_output(model, &out, &m, &what, dxf, |p| {
+        format!("F{}", count(p, "source.face"))
+    });
 
     // Panels: one per face of the mesh the scheme used (after splits).
+    let panels = count(&m, "counts.panels");
     let faces = count(&m, "input.faces");
     assert_eq!(panels, faces, "{what}: one panel per face");
     let own_faces = obj_face_count(model);
@@ -417,104 +94,6 @@ fn check_build(model: &Path, size: &str, dxf: DxfCheck) {
             "{what}: {split} faces split into triangles, yet only {faces} faces from {own_faces}"
         );
     }
-
-    // Sheets against the manifest.
-    assert_eq!(
-        checked.svg_files.len(),
-        sheets,
-        "{what}: SVG files = counts.sheets"
-    );
-    assert_eq!(total.panels, panels, "{what}: panels on the sheets");
-    assert_eq!(
-        total.holes,
-        count(&m, "counts.holes"),
-        "{what}: holes on the sheets"
-    );
-    let panel_area = num(&m, "panel_area");
-    assert!(
-        close(total.panel_area, panel_area, 1e-4),
-        "{what}: outlines on the sheets enclose {} mm², manifest panel_area {panel_area}",
-        total.panel_area
-    );
-    for (kind, drawn) in [
-        ("cut", total.cut_length),
-        ("score", total.score_length),
-        ("engrave", total.engrave_length),
-    ] {
-        let said = num(&m, &format!("lengths.{kind}"));
-        assert!(
-            close(drawn, said, 1e-4),
-            "{what}: {kind} length drawn {drawn} mm, manifest says {said} mm"
-        );
-    }
-    let entries = m["sheets"].as_array().expect("manifest sheets list");
-    assert_eq!(entries.len(), sheets, "{what}: manifest sheets list");
-    for (k, (entry, (file, stats))) in entries
-        .iter()
-        .zip(checked.svg_files.iter().zip(&checked.stats))
-        .enumerate()
-    {
-        assert_eq!(count(entry, "sheet"), k + 1, "{what}: sheet numbers");
-        assert_eq!(
-            entry["file"].as_str(),
-            Some(file.as_str()),
-            "{what}: sheet file"
-        );
-        assert_eq!(
-            count(entry, "panels"),
-            stats.panels,
-            "{what}: panels on {file}"
-        );
-    }
-
-    // The per-panel list: one entry per panel, ids F<face>, on the sheet that holds it.
-    let list = m["panels"].as_array().expect("manifest panels list");
-    assert_eq!(list.len(), panels, "{what}: manifest panels list");
-    let mut ids = BTreeSet::new();
-    let mut per_sheet = vec![0usize; sheets];
-    let mut area_sum = 0.0;
-    for p in list {
-        let id = p["id"].as_str().unwrap();
-        let face = count(p, "source.face");
-        assert_eq!(id, format!("F{face}"), "{what}: panel id names its face");
-        assert!(ids.insert(id.to_string()), "{what}: panel id {id} twice");
-        let sheet = count(p, "sheet");
-        assert!(
-            (1..=sheets).contains(&sheet),
-            "{what}: {id} on sheet {sheet}"
-        );
-        per_sheet[sheet - 1] += 1;
-        area_sum += num(p, "area");
-    }
-    let on_sheets: Vec<usize> = checked.stats.iter().map(|s| s.panels).collect();
-    assert_eq!(per_sheet, on_sheets, "{what}: panels per sheet");
-    assert!(
-        close(area_sum, panel_area, 1e-6) || (area_sum - panel_area).abs() < 1e-4 * panels as f64,
-        "{what}: Σ panel areas {area_sum} vs panel_area {panel_area}"
-    );
-
-    // Layout figures.
-    let lower = count(&m, "counts.sheets_lower_bound");
-    assert!(
-        sheets >= lower,
-        "{what}: {sheets} sheets below the lower bound {lower}"
-    );
-    let spec = sheet_spec(&m);
-    let usable = (spec.width - 2.0 * spec.margin) * (spec.height - 2.0 * spec.margin);
-    let ratio = panel_area / usable;
-    if (ratio - ratio.round()).abs() > 1e-6 {
-        assert_eq!(lower, ratio.ceil() as usize, "{what}: sheets_lower_bound");
-    }
-    let utilization = num(&m, "utilization");
-    let wanted = panel_area / (sheets as f64 * spec.width * spec.height);
-    assert!(
-        (utilization - wanted).abs() <= 1e-4,
-        "{what}: utilization {utilization}, panel_area / sheet area = {wanted}"
-    );
-    eprintln!(
-        "{what}: {panels} panels on {sheets} sheets (lower bound {lower}), {} holes",
-        total.holes
-    );
 }
 
 #[test]
@@ -615,21 +194,10 @@ fn face_areas_equal_the_model_surface_area() {
 
 /// `unfold inspect MODEL --json --size SIZE`: the built surface area in mm².
 fn surface_area_mm2(path: &Path, size: &str) -> f64 {
-    let inspect = finish(
-        unfold_command()
-            .arg("inspect")
-            .arg(path)
-            .args(["--json", "--size", size]),
-    );
-    assert_eq!(
-        inspect.code,
-        Some(0),
-        "inspect {}: {}",
-        path.display(),
-        inspect.stderr
-    );
-    let facts: Value = serde_json::from_str(&inspect.stdout).expect("inspect --json");
-    num(&facts, "physical.surface_area_mm2")
+    num(
+        &inspect_json(path, &["--size", size]),
+        "physical.surface_area_mm2",
+    )
 }
 
 #[test]
@@ -991,21 +559,6 @@ fn output_is_byte_identical_across_runs_and_threads() {
 // 5. Golden files
 // =======================================================================================
 
-/// The first line where two texts differ, for the failure message.
-fn first_difference(want: &[u8], got: &[u8]) -> String {
-    let (want, got) = (String::from_utf8_lossy(want), String::from_utf8_lossy(got));
-    for (k, (a, b)) in want.lines().zip(got.lines()).enumerate() {
-        if a != b {
-            return format!("line {}:\n  golden: {a}\n  now:    {b}", k + 1);
-        }
-    }
-    format!(
-        "one is a prefix of the other ({} and {} lines)",
-        want.lines().count(),
-        got.lines().count()
-    )
-}
-
 #[test]
 fn golden_files_of_a_small_model() {
     let golden = crate_dir().join("tests/golden/tetrahedron-half-edge");
@@ -1022,46 +575,10 @@ fn golden_files_of_a_small_model() {
             .arg(&out),
     );
     assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let now = folder_files(&out);
     let manifest = read_manifest(&out);
     assert_eq!(manifest["input"]["path"], "models/tetrahedron.obj");
-    for (name, bytes) in &now {
-        let text = String::from_utf8_lossy(bytes);
-        assert!(
-            !text.contains(&*tmp.path().to_string_lossy()),
-            "{name} names the temporary folder"
-        );
-    }
-
-    if std::env::var("UNFOLD_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
-        if golden.exists() {
-            std::fs::remove_dir_all(&golden).unwrap();
-        }
-        std::fs::create_dir_all(&golden).unwrap();
-        for (name, bytes) in &now {
-            std::fs::write(golden.join(name), bytes).unwrap();
-        }
-        eprintln!("UNFOLD_UPDATE_GOLDEN=1: rewrote {}", golden.display());
+    if compare_with_golden(&out, &golden, tmp.path(), "build_half_edge") == Golden::Rewritten {
         return;
-    }
-    assert!(
-        golden.is_dir(),
-        "{} is missing; create it with UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_half_edge golden",
-        golden.display()
-    );
-    let want = folder_files(&golden);
-    assert_eq!(
-        now.keys().collect::<Vec<_>>(),
-        want.keys().collect::<Vec<_>>(),
-        "the output files differ from the golden ones"
-    );
-    for (name, bytes) in &want {
-        assert!(
-            &now[name] == bytes,
-            "{name} differs from {}; if the change is intended, rerun with UNFOLD_UPDATE_GOLDEN=1\nfirst difference at {}",
-            golden.join(name).display(),
-            first_difference(bytes, &now[name])
-        );
     }
     // The golden sheets themselves pass the independent check.
     let sheets = check_sheets(&out, &manifest, DxfCheck::All);

@@ -17,7 +17,8 @@ use super::polygons::Polygons;
 pub struct SplitReport {
     /// Faces split because they were not planar within the tolerance.
     pub non_planar: Vec<u32>,
-    /// Faces split because they were not star-shaped from their centre.
+    /// Faces split because they were not star-shaped from their centre (or, when the
+    /// scheme needs it, not convex).
     pub not_star_shaped: Vec<u32>,
 }
 
@@ -40,9 +41,20 @@ pub fn is_star_shaped_from_centre(mesh: &Mesh, f: FaceId) -> bool {
     })
 }
 
+/// True when every corner of the face turns left (seen from outside).
+pub fn is_convex(mesh: &Mesh, f: FaceId) -> bool {
+    let n = mesh.face_normal(f);
+    let corners: Vec<DVec3> = mesh.face_positions(f).collect();
+    let m = corners.len();
+    (0..m).all(|i| {
+        let (a, b, c) = (corners[i], corners[(i + 1) % m], corners[(i + 2) % m]);
+        (b - a).cross(c - b).dot(n) > 0.0
+    })
+}
+
 /// The faces that need splitting: non-planar beyond `planarity_tol` (relative to face
-/// size) or not star-shaped from their centre.
-pub fn faces_to_split(mesh: &Mesh, planarity_tol: f64) -> SplitReport {
+/// size), or not star-shaped from their centre, or (with `convex`) not convex.
+pub fn faces_to_split(mesh: &Mesh, planarity_tol: f64, convex: bool) -> SplitReport {
     let mut report = SplitReport::default();
     let errors = mesh.face_planarity_errors();
     for f in mesh.faces() {
@@ -51,7 +63,7 @@ pub fn faces_to_split(mesh: &Mesh, planarity_tol: f64) -> SplitReport {
         }
         if errors[f.index()] > planarity_tol {
             report.non_planar.push(f.0);
-        } else if !is_star_shaped_from_centre(mesh, f) {
+        } else if !is_star_shaped_from_centre(mesh, f) || (convex && !is_convex(mesh, f)) {
             report.not_star_shaped.push(f.0);
         }
     }
@@ -242,7 +254,7 @@ mod tests {
             DVec3::new(0.0, 1.0, 0.3),
         ];
         let mesh = build_from_faces(positions, &[[0u32, 1, 2, 3]]).unwrap();
-        let report = faces_to_split(&mesh, 1e-3);
+        let report = faces_to_split(&mesh, 1e-3, false);
         assert_eq!(report.non_planar, vec![0]);
         let split = split_faces(&mesh, &report).unwrap();
         assert_eq!(split.face_count(), 2);

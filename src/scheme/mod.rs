@@ -3,7 +3,10 @@
 //!
 //! Adding a scheme: one file here and one arm in [`build_panels`].
 
+pub mod edge_panel;
 pub mod half_edge;
+pub mod quad_edge;
+pub mod winged_edge;
 
 use glam::DVec3;
 
@@ -16,6 +19,15 @@ use crate::panel::Panel;
 pub struct SchemeOptions {
     /// Face band scale `s`: corners move toward the face centre, `s·v + (1−s)·c`.
     pub face_scale: f64,
+    /// Edge band control points `b·v + (1−b)·m` (quad-edge).
+    pub bridge_scale: f64,
+    /// Flap inner line at this fraction toward the face centre (quad-edge).
+    pub flap_scale: f64,
+    /// Strips of the Bézier bend (quad-edge).
+    pub samples: u32,
+    /// Winged-edge wings: 0 both half-length, 1 one full-length wing on the next edge,
+    /// −1 on the previous edge.
+    pub shift: i32,
     /// Tabs on interior edges (half-edge scheme).
     pub tabs: bool,
     /// Wanted height of a tab's overlap with its neighbour (mm).
@@ -43,8 +55,14 @@ pub struct SchemeOutput {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SchemeError {
     /// The scheme exists in the command line but not yet in the tool.
-    #[error("the {0} scheme is not implemented yet in this version; use --scheme half-edge")]
+    #[error("the {0} scheme is not implemented yet in this version; use --scheme half-edge, quad-edge or winged-edge")]
     NotImplemented(SchemeName),
+}
+
+/// True when the scheme needs convex faces (its flaps follow the neighbouring band
+/// edges, which only bound a flap inside a convex face).
+pub fn needs_convex_faces(name: SchemeName) -> bool {
+    !matches!(name, SchemeName::HalfEdge)
 }
 
 /// Runs the named scheme.
@@ -55,6 +73,8 @@ pub fn build_panels(
 ) -> Result<SchemeOutput, SchemeError> {
     match name {
         SchemeName::HalfEdge => Ok(half_edge::panels(mesh, options)),
+        SchemeName::QuadEdge => Ok(quad_edge::panels(mesh, options)),
+        SchemeName::WingedEdge => Ok(winged_edge::panels(mesh, options)),
         other => Err(SchemeError::NotImplemented(other)),
     }
 }

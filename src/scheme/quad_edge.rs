@@ -1,0 +1,137 @@
+//! The quad-edge scheme (thesis ch. 4.2): one panel per edge. For an interior edge
+//! (v, v′) between faces f and f′ the panel is
+//!
+//! - a flap in f's plane: the strip of f's face band between the band edge and an inner
+//!   line (the band corners moved `F` toward the face centre), its sides along the
+//!   neighbouring band edges;
+//! - a bend: the Bézier surface whose rails are the quadratic curves
+//!   `f-band(v) → b·v + (1−b)·m → f′-band(v)` and the same at v′, sampled at the same
+//!   `t = k/n` on both rails. All three control pairs are parallel to the edge, so every
+//!   ruling is too and each strip between two rulings is a planar trapezoid: the bend is
+//!   exactly developable;
+//! - a flap in f′'s plane.
+//!
+//! At every face corner (f, v) the flaps of the two edges meeting there overlap; that
+//! overlap is the connection between the two panels, and its fastener holes are placed
+//! once, in f's plane, so both panels carry them at the same 3D points. A boundary edge's
+//! panel is its one flap. The bend and the panel assembly live in
+//! [`super::edge_panel`], shared with the winged-edge scheme.
+
+use glam::DVec2;
+use rayon::prelude::*;
+
+use super::edge_panel::{band, corner_half_edges, edge_panels, place_pins, FaceFlaps};
+use super::{SchemeOptions, SchemeOutput};
+use crate::mesh::{FaceId, Mesh};
+use crate::plane::clip_half_plane;
+
+pub use super::edge_panel::panel_id;
+
+/// Builds the edge panels of a mesh whose faces are planar and convex.
+pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
+    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
+        .into_par_iter()
+        .map(|f| face_flaps(mesh, FaceId(f), options))
+        .collect();
+    let panels = edge_panels(mesh, &faces, options);
+    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
+    SchemeOutput {
+        panels,
+        connections,
+        notes: edge_scheme_notes(mesh, &faces, connections, options),
+    }
+}
+
+/// Report lines shared by the edge schemes: holes that did not fit, boundary panels.
+pub fn edge_scheme_notes(
+    mesh: &Mesh,
+    faces: &[FaceFlaps],
+    connections: usize,
+    options: &SchemeOptions,
+) -> Vec<String> {
+    let reduced: usize = faces.iter().map(|f| f.reduced).sum();
+    let bare: usize = faces.iter().map(|f| f.bare).sum();
+    let mut notes = Vec::new();
+    if reduced > 0 {
+        notes.push(format!(
+            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlap cannot hold more {} mm holes with one diameter of material around each; a larger --size, smaller --hole-diameter or larger --flap-scale helps",
+            options.holes, options.hole_diameter
+        ));
+    }
+    let boundary = mesh.edges().filter(|&e| mesh.is_boundary_edge(e)).count();
+    if boundary > 0 {
+        notes.push(format!(
+            "{boundary} boundary edges have a panel with a single flap and no bend"
+        ));
+    }
+    notes
+}
+
+/// Band, flaps and corner overlaps of one face, computed in its plane.
+fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
+    let (band3, b, frame) = band(mesh, f, options);
+    let n = b.len();
+    let half_edges = corner_half_edges(mesh, f);
+    let flap = options.flap_scale;
+    // Inner line of band edge k, directed like the edge, through the band corners moved
+    // toward the centre (the frame's origin). The flap is the band clipped to the strip
+    // between its edge and that line: the same as running its sides along the
+    // neighbouring band edges, and it never leaves the band when a neighbouring edge is
+    // nearly parallel (sliver triangles).
+    let inner_line = |k: usize| ((1.0 - flap) * b[k], (1.0 - flap) * b[(k + 1) % n]);
+    let flaps: Vec<Vec<DVec2>> = (0..n)
+        .map(|k| {
+            let (p, q) = inner_line(k);
+            // Left of q → p is between the edge and the inner line.
+            let clipped = clip_half_plane(&b, q, p);
+            // Start the loop at B_k, B_k+1 (both kept exactly by the clip).
+            let start = clipped.iter().position(|&x| x == b[k]).unwrap_or(0);
+            (0..clipped.len())
+                .map(|i| clipped[(start + i) % clipped.len()])
+                .collect()
+        })
+        .collect();
+
+    let mut parts = FaceFlaps {
+        band: band3,
+        flap_rest: flaps
+            .iter()
+            .map(|f| f.iter().skip(2).map(|&q| frame.to3(q)).collect())
+            .collect(),
+        flap_holes: vec![Vec::new(); n],
+        corner_label: Vec::with_capacity(n),
+        reduced: 0,
+        bare: 0,
+    };
+    for k in 0..n {
+        let prev = (k + n - 1) % n;
+        // The overlap at corner k: the previous edge's flap clipped by this edge's strip.
+        let (p, q) = inner_line(k);
+        let overlap = clip_half_plane(&flaps[prev], q, p);
+        let centre = if overlap.is_empty() {
+            b[k]
+        } else {
+            overlap.iter().copied().sum::<DVec2>() / overlap.len() as f64
+        };
+        parts.corner_label.push(frame.to3(centre));
+        // Pins along the line from the corner through the overlap's centre.
+        let (pins, fewer) = place_pins(
+            &overlap,
+            centre,
+            centre - b[k],
+            options.holes,
+            options.hole_diameter,
+        );
+        parts.reduced += fewer as usize;
+        parts.bare += (options.holes > 0 && pins.is_empty()) as usize;
+        // The connection at corner k is named by the half-edge leaving it; both flaps
+        // meeting there carry its holes.
+        let connection = half_edges[k].0;
+        for pin in pins {
+            let p = frame.to3(pin);
+            parts.flap_holes[prev].push((p, connection));
+            parts.flap_holes[k].push((p, connection));
+        }
+    }
+    parts
+}

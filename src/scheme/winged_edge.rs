@@ -1,0 +1,125 @@
+//! The winged-edge scheme (thesis ch. 4.3): quad-edge panels whose flaps have parallel
+//! sides and carry wings along the neighbouring face edges.
+//!
+//! In a face, band edge k owns the sector R_k of the ring between the band and the
+//! inner polygon (the band corners moved `F` toward the centre): B_k, B_k+1, I_k+1, I_k.
+//! Its main flap is R_k. Wings cover neighbouring sectors:
+//!
+//! - `--shift 0`: half of R_k+1 next to corner k+1 and half of R_k−1 next to corner k;
+//! - `--shift 1`: all of R_k+1; `--shift -1`: all of R_k−1.
+//!
+//! Every sector is then covered by exactly two panels (its owner's main flap and a
+//! neighbour's wing), and each such shared region is part of the connection at the face
+//! corner it touches; its holes go through both panels at the same 3D points. With
+//! shift 0 a corner has two shared regions (2 × holes per connection), with ±1 one.
+
+use glam::DVec2;
+use rayon::prelude::*;
+
+use super::edge_panel::{band, corner_half_edges, edge_panels, place_pins, FaceFlaps};
+use super::quad_edge::edge_scheme_notes;
+use super::{SchemeOptions, SchemeOutput};
+use crate::mesh::{FaceId, Mesh};
+
+/// Builds the winged edge panels of a mesh whose faces are planar and convex.
+pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
+    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
+        .into_par_iter()
+        .map(|f| face_flaps(mesh, FaceId(f), options))
+        .collect();
+    let panels = edge_panels(mesh, &faces, options);
+    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
+    SchemeOutput {
+        panels,
+        connections,
+        notes: edge_scheme_notes(mesh, &faces, connections, options),
+    }
+}
+
+fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
+    let (band3, b, frame) = band(mesh, f, options);
+    let n = b.len();
+    let half_edges = corner_half_edges(mesh, f);
+    let at = |k: usize| b[k % n];
+    // Inner corners (the centre is the frame's origin) and edge midpoints.
+    let inner = |k: usize| (1.0 - options.flap_scale) * at(k);
+    let mid = |k: usize| 0.5 * (at(k) + at(k + 1));
+    let inner_mid = |k: usize| 0.5 * (inner(k) + inner(k + 1));
+    let shift = options.shift;
+
+    // The flap outline of edge k after B_k, B_k+1 (counter-clockwise).
+    let rest: Vec<Vec<DVec2>> = (0..n)
+        .map(|k| match shift {
+            0 => vec![
+                mid(k + 1),
+                inner_mid(k + 1),
+                inner(k + 1),
+                inner(k),
+                inner_mid(k + n - 1),
+                mid(k + n - 1),
+            ],
+            s if s > 0 => vec![at(k + 2), inner(k + 2), inner(k + 1), inner(k)],
+            _ => vec![inner(k + 1), inner(k), inner(k + n - 1), at(k + n - 1)],
+        })
+        .collect();
+
+    // Shared regions, each with the corner (connection) it belongs to, and the two
+    // band edges whose flaps cover it.
+    let sector = |k: usize| vec![at(k), at(k + 1), inner(k + 1), inner(k)];
+    let mut shared: Vec<(usize, [usize; 2], Vec<DVec2>)> = Vec::new();
+    for k in 0..n {
+        let prev = (k + n - 1) % n;
+        match shift {
+            0 => {
+                // Half of R_prev next to corner k, and half of R_k next to corner k.
+                shared.push((
+                    k,
+                    [prev, k],
+                    vec![mid(prev), at(k), inner(k), inner_mid(prev)],
+                ));
+                shared.push((k, [prev, k], vec![at(k), mid(k), inner_mid(k), inner(k)]));
+            }
+            // Edge prev's wing covers all of R_k.
+            s if s > 0 => shared.push((k, [prev, k], sector(k))),
+            // Edge k's wing covers all of R_prev.
+            _ => shared.push((k, [prev, k], sector(prev))),
+        }
+    }
+
+    let mut parts = FaceFlaps {
+        band: band3,
+        flap_rest: rest
+            .iter()
+            .map(|r| r.iter().map(|&q| frame.to3(q)).collect())
+            .collect(),
+        flap_holes: vec![Vec::new(); n],
+        corner_label: (0..n)
+            .map(|k| frame.to3(0.5 * (at(k) + inner(k))))
+            .collect(),
+        reduced: 0,
+        bare: 0,
+    };
+    let mut placed_at_corner = vec![0usize; n];
+    let mut short_at_corner = vec![false; n];
+    for (corner, [e1, e2], region) in &shared {
+        let centre = region.iter().copied().sum::<DVec2>() / region.len() as f64;
+        // Pins along the band edge the region lies on.
+        let along = region[1] - region[0];
+        let (pins, fewer) = place_pins(region, centre, along, options.holes, options.hole_diameter);
+        short_at_corner[*corner] |= fewer;
+        placed_at_corner[*corner] += pins.len();
+        let connection = half_edges[*corner].0;
+        for pin in pins {
+            let p = frame.to3(pin);
+            parts.flap_holes[*e1].push((p, connection));
+            parts.flap_holes[*e2].push((p, connection));
+        }
+    }
+    parts.reduced = short_at_corner.iter().filter(|&&s| s).count();
+    parts.bare = if options.holes > 0 {
+        placed_at_corner.iter().filter(|&&c| c == 0).count()
+    } else {
+        0
+    };
+    parts
+}
