@@ -304,6 +304,10 @@ fn build_manifest(
             name: job.scheme.to_string(),
             params: manifest::SchemeParams {
                 face_scale: o.face_scale,
+                bridge_scale: o.bridge_scale,
+                flap_scale: o.flap_scale,
+                samples: o.samples,
+                shift: o.shift,
                 connectors: if o.tabs { "tab" } else { "none" },
                 tab_height: round4(o.tab_height),
                 holes: o.holes,

@@ -79,6 +79,14 @@ pub struct Scheme {
 pub struct SchemeParams {
     /// Face band scale.
     pub face_scale: f64,
+    /// Edge band control point scale (edge schemes).
+    pub bridge_scale: f64,
+    /// Flap depth fraction (edge schemes).
+    pub flap_scale: f64,
+    /// Bend strips (edge schemes).
+    pub samples: u32,
+    /// Winged-edge wing shift.
+    pub shift: i32,
     /// Connectors: "tab" or "none".
     pub connectors: &'static str,
     /// Wanted tab overlap (mm).
