@@ -5,6 +5,7 @@
 //! graph rotation system are views of it, not separate structures.
 
 pub mod build;
+pub mod ergs;
 pub mod geometry;
 pub mod halfedge;
 pub mod ids;
