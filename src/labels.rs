@@ -41,58 +41,72 @@ pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [D
     ]
 }
 
-/// Fits the panel's wanted labels; returns how many were left out. The panel's own id
-/// goes first so it gets the room it needs.
-pub fn fit_labels(panel: &mut FlatPanel, options: LabelOptions) -> usize {
+/// How many labels of each kind were left out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LeftOut {
+    /// Panel ids.
+    pub panel: usize,
+    /// Partner ids at connections.
+    pub partner: usize,
+    /// Vertex and face marks.
+    pub mark: usize,
+}
+
+impl LeftOut {
+    /// All kinds together.
+    pub fn total(&self) -> usize {
+        self.panel + self.partner + self.mark
+    }
+
+    fn count(&mut self, kind: LabelKind) {
+        match kind {
+            LabelKind::Panel => self.panel += 1,
+            LabelKind::Partner => self.partner += 1,
+            LabelKind::Mark => self.mark += 1,
+        }
+    }
+}
+
+impl std::ops::Add for LeftOut {
+    type Output = LeftOut;
+    fn add(self, o: LeftOut) -> LeftOut {
+        LeftOut {
+            panel: self.panel + o.panel,
+            partner: self.partner + o.partner,
+            mark: self.mark + o.mark,
+        }
+    }
+}
+
+/// Fits the panel's wanted labels; returns how many of each kind were left out. Panel
+/// ids go first, then partner ids, then marks, so the important ones get the room.
+pub fn fit_labels(panel: &mut FlatPanel, options: LabelOptions) -> LeftOut {
     let mut order: Vec<usize> = (0..panel.wanted_labels.len()).collect();
-    order.sort_by_key(|&i| (panel.wanted_labels[i].kind != LabelKind::Panel, i));
+    order.sort_by_key(|&i| (panel.wanted_labels[i].kind, i));
     let mut placed: Vec<[DVec2; 4]> = Vec::new();
     let mut labels = Vec::new();
-    let mut dropped = 0;
+    let mut dropped = LeftOut::default();
     for i in order {
-        let wanted = &panel.wanted_labels[i];
+        let wanted = panel.wanted_labels[i].clone();
         let frame = panel.frames[wanted.facet as usize];
-        let facet: Vec<DVec2> = panel.facets[wanted.facet as usize]
-            .iter()
-            .map(|&k| panel.points[k as usize])
-            .collect();
-        let anchor = frame.to_2d(wanted.anchor);
-        let direction = frame.direction_to_2d(wanted.direction).normalize_or_zero();
-        if direction == DVec2::ZERO {
-            dropped += 1;
-            continue;
+        let mut attempts = vec![Attempt {
+            facet: wanted.facet as usize,
+            anchor: frame.to_2d(wanted.anchor),
+            direction: frame.direction_to_2d(wanted.direction).normalize_or_zero(),
+            on_edge: wanted.on_edge,
+            slide: wanted.slide,
+        }];
+        if wanted.kind == LabelKind::Panel {
+            // A panel without its id cannot be found: if the wanted place is too
+            // small, try the panel's largest facets.
+            attempts.extend(fallback_attempts(panel, wanted.facet as usize));
         }
         let text_width = text_strokes(&wanted.text).width;
-        let mut height = wanted.height;
-        let mut fitted = None;
-        // Positions along the reading direction, nearest the anchor first.
-        let slides: Vec<f64> = if wanted.slide > 0.0 {
-            [0.0, -0.5, 0.5, -1.0, 1.0]
-                .iter()
-                .map(|f| f * wanted.slide)
-                .collect()
-        } else {
-            vec![0.0]
-        };
-        'sizes: while height >= options.min_height {
-            for &shift in &slides {
-                let mut center = anchor + shift * direction;
-                if wanted.on_edge {
-                    // Twice the margin off the edge: the fit test wants at least one
-                    // margin, and rounding must not make an exact margin fail every
-                    // size.
-                    center += (2.0 * options.margin + 0.5 * height) * direction.perp();
-                }
-                let bx = label_box(center, direction, text_width * height, height);
-                if box_fits(&bx, &facet, panel, &placed, options.margin) {
-                    fitted = Some((center, bx));
-                    break 'sizes;
-                }
-            }
-            height *= SHRINK;
-        }
+        let fitted = attempts.iter().find_map(|attempt| {
+            fit_one(panel, attempt, text_width, wanted.height, &placed, options)
+        });
         match fitted {
-            Some((center, bx)) => {
+            Some((center, direction, height, bx)) => {
                 placed.push(bx);
                 labels.push(FlatLabel {
                     text: wanted.text.clone(),
@@ -102,11 +116,106 @@ pub fn fit_labels(panel: &mut FlatPanel, options: LabelOptions) -> usize {
                     kind: wanted.kind,
                 });
             }
-            None => dropped += 1,
+            None => dropped.count(wanted.kind),
         }
     }
     panel.labels = labels;
     dropped
+}
+
+/// One place to try a label.
+struct Attempt {
+    facet: usize,
+    anchor: DVec2,
+    direction: DVec2,
+    on_edge: bool,
+    slide: f64,
+}
+
+/// The three largest other facets, each at its centroid along its longest edge.
+fn fallback_attempts(panel: &FlatPanel, skip: usize) -> Vec<Attempt> {
+    let mut facets: Vec<(f64, usize)> = panel
+        .facets
+        .iter()
+        .enumerate()
+        .filter(|&(k, _)| k != skip)
+        .map(|(k, f)| {
+            let pts: Vec<DVec2> = f.iter().map(|&i| panel.points[i as usize]).collect();
+            (crate::plane::area(&pts), k)
+        })
+        .collect();
+    facets.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    facets
+        .into_iter()
+        .take(3)
+        .map(|(_, k)| {
+            let pts: Vec<DVec2> = panel.facets[k]
+                .iter()
+                .map(|&i| panel.points[i as usize])
+                .collect();
+            let n = pts.len();
+            let longest = (0..n)
+                .max_by(|&a, &b| {
+                    let la = pts[a].distance(pts[(a + 1) % n]);
+                    let lb = pts[b].distance(pts[(b + 1) % n]);
+                    la.total_cmp(&lb).then(b.cmp(&a))
+                })
+                .unwrap_or(0);
+            Attempt {
+                facet: k,
+                anchor: pts.iter().copied().sum::<DVec2>() / n as f64,
+                direction: (pts[(longest + 1) % n] - pts[longest]).normalize_or_zero(),
+                on_edge: false,
+                slide: 0.0,
+            }
+        })
+        .collect()
+}
+
+/// The largest height (from `wanted` down, shrinking) and position at which a label
+/// fits in its attempt's facet: (centre, direction, height, box).
+fn fit_one(
+    panel: &FlatPanel,
+    attempt: &Attempt,
+    text_width: f64,
+    wanted: f64,
+    placed: &[[DVec2; 4]],
+    options: LabelOptions,
+) -> Option<(DVec2, DVec2, f64, [DVec2; 4])> {
+    let direction = attempt.direction;
+    if direction == DVec2::ZERO {
+        return None;
+    }
+    let facet: Vec<DVec2> = panel.facets[attempt.facet]
+        .iter()
+        .map(|&k| panel.points[k as usize])
+        .collect();
+    // Positions along the reading direction, nearest the anchor first.
+    let slides: Vec<f64> = if attempt.slide > 0.0 {
+        [0.0, -0.5, 0.5, -1.0, 1.0]
+            .iter()
+            .map(|f| f * attempt.slide)
+            .collect()
+    } else {
+        vec![0.0]
+    };
+    let mut height = wanted;
+    while height >= options.min_height {
+        for &shift in &slides {
+            let mut center = attempt.anchor + shift * direction;
+            if attempt.on_edge {
+                // Twice the margin off the edge: the fit test wants at least one
+                // margin, and rounding must not make an exact margin fail every size.
+                center += (2.0 * options.margin + 0.5 * height) * direction.perp();
+            }
+            let bx = label_box(center, direction, text_width * height, height);
+            if box_fits(&bx, &facet, panel, placed, options.margin) {
+                return Some((center, direction, height, bx));
+            }
+        }
+        height *= SHRINK;
+    }
+    None
 }
 
 fn box_fits(

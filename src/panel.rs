@@ -40,13 +40,15 @@ pub struct Hole {
 }
 
 /// What a label says.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LabelKind {
     /// The panel's own id.
     Panel,
     /// The id of the partner panel at a connection.
     Partner,
+    /// Extra assembly marks: vertex and face ids (thesis software style).
+    Mark,
 }
 
 /// An engraved text: anchored at the centre of its text box, or, for `on_edge` labels,

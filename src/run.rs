@@ -13,7 +13,7 @@ use crate::error::{Error, InputError, Result};
 use crate::export::manifest::{self, round4, Manifest};
 use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
 use crate::flatten::flatten;
-use crate::labels::{fit_labels, LabelOptions};
+use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 use crate::nest::{shelf::shelf_layout, Layout, SheetSpec};
@@ -130,10 +130,10 @@ pub fn run(job: &Job) -> Result<Outcome> {
             bad.id
         )));
     }
-    let labels_left_out: usize = flat
+    let labels_left_out = flat
         .par_iter_mut()
         .map(|p| fit_labels(p, LabelOptions::default()))
-        .sum();
+        .reduce(LeftOut::default, |a, b| a + b);
     clock.lap("flatten");
 
     let sheet = SheetSpec {
@@ -252,7 +252,7 @@ fn build_manifest(
     flat: &[FlatPanel],
     layout: &Layout,
     lengths: Lengths,
-    labels_left_out: usize,
+    labels_left_out: LeftOut,
     sheets: Vec<manifest::SheetEntry>,
 ) -> Manifest {
     let o = &job.scheme_options;
@@ -332,7 +332,9 @@ fn build_manifest(
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
             cycles: 0,
-            labels_left_out,
+            labels_left_out: labels_left_out.total(),
+            panel_ids_left_out: labels_left_out.panel,
+            partner_ids_left_out: labels_left_out.partner,
         },
         panel_area: round4(panel_area),
         utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
@@ -378,10 +380,11 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         m.lengths.cut, m.lengths.score, m.lengths.engrave, m.max_developability_error
     );
     if c.labels_left_out > 0 {
+        let marks = c.labels_left_out - c.panel_ids_left_out - c.partner_ids_left_out;
         let _ = writeln!(
             s,
-            "labels: {} left out (no room for a 1.5 mm cap height)",
-            c.labels_left_out
+            "labels left out (no room for a 1.5 mm cap height): {} panel ids, {} partner ids, {} vertex/face marks",
+            c.panel_ids_left_out, c.partner_ids_left_out, marks
         );
     }
     for note in &outcome.notes {

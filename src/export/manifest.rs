@@ -133,8 +133,12 @@ pub struct Counts {
     pub connections: usize,
     /// Woven cycles (0 for other schemes).
     pub cycles: usize,
-    /// Labels left out because no legible size fits.
+    /// Labels left out because no legible size fits (all kinds).
     pub labels_left_out: usize,
+    /// Of those, panel ids.
+    pub panel_ids_left_out: usize,
+    /// Of those, partner ids at connections.
+    pub partner_ids_left_out: usize,
 }
 
 /// Lengths of laser paths (mm).

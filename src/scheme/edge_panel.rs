@@ -340,7 +340,7 @@ fn flap_labels(
             direction: along,
             height: options.label_height,
             facet,
-            kind: LabelKind::Partner,
+            kind: LabelKind::Mark,
             on_edge: false,
             slide: 0.0,
         });
@@ -351,7 +351,7 @@ fn flap_labels(
         direction: along,
         height: options.label_height,
         facet,
-        kind: LabelKind::Partner,
+        kind: LabelKind::Mark,
         on_edge: false,
         slide: 0.1 * a.distance(b),
     });
