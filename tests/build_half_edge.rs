@@ -840,7 +840,7 @@ fn labels_are_inside_their_panels() {
     assert_eq!(connections, 100);
     let mut left_out = 0;
     for fp in &mut flat {
-        left_out += unfold::labels::fit_labels(fp, Default::default());
+        left_out += unfold::labels::fit_labels(fp, Default::default()).total();
     }
     assert_eq!(left_out, 0);
     let mut partner_labels = 0;

@@ -12,10 +12,15 @@
 //!   malformed file: for tests that already checked the sheet).
 //! * [`check_dxf_matches_svg`] — runs `tests/check_dxf.py` (ezdxf, strict read + audit)
 //!   on a DXF and compares its entities with the SVG geometry (y flipped).
+//! * [`build`] — helpers for the end-to-end build tests of every scheme (running the
+//!   binary, reading the manifest, checking an output folder, the library's pipeline up
+//!   to the flat panels, golden files).
 //!
 //! Terminology: a *panel* is a closed CUT path not contained in another closed CUT path;
 //! closed CUT paths inside a panel are *inner cuts*; CUT circles are *holes*.
 #![allow(dead_code)]
+
+pub mod build;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;

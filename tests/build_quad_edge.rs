@@ -1,0 +1,1333 @@
+//! End-to-end tests of the build pipeline with the quad-edge scheme (SPEC §2): one panel
+//! per edge (a flap in each of its two faces joined by a bend of planar strips), one
+//! connection per face corner joining the panels of the two edges that meet there.
+//!
+//! As in `tests/build_half_edge.rs`, the real binary writes its output folder into a
+//! temporary directory and the independent sheet checker of `tests/common` reads it
+//! back (every SVG; every DXF through ezdxf, only the first and the last for
+//! fertility and horse_quad unless `UNFOLD_FULL_DXF=1`); the geometric facts are
+//! checked at library level on the pipeline of `src/run.rs` (`common::build::pipeline`),
+//! with the mesh the scheme used: counts against the mesh, holes followed back to 3D,
+//! bend strips planar with rulings parallel to the edge and on the rails of the spec's
+//! formula, flaps in their face, outlines simple, unrolling isometric.
+//!
+//! Tests that use `../shared/models` skip with a message when that folder is absent.
+//!
+//! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_quad_edge golden` rewrites
+//! `tests/golden/hexahedron-quad-edge/`.
+
+mod common;
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+
+use glam::{DVec2, DVec3};
+use serde_json::Value;
+use tempfile::TempDir;
+
+use common::build::{
+    check_output, check_sheets, compare_with_golden, count, crate_dir, distance_to_border, finish,
+    inside, inspect_json, model, num, pipeline, read_manifest, read_simple_obj, resolve,
+    shared_models, unfold_command, DxfCheck, Golden, Pipeline, Run,
+};
+use common::svg_circles;
+use unfold::config::{BuildOptions, Job, SchemeName};
+use unfold::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
+use unfold::panel::{FlatPanel, Panel, Source};
+
+// =======================================================================================
+// Helpers
+// =======================================================================================
+
+/// `unfold MODEL --scheme quad-edge --size SIZE --out OUT EXTRA…`: the manifest and the
+/// run (its report is on stderr).
+fn build_run(model: &Path, size: &str, out: &Path, extra: &[&str]) -> (Value, Run) {
+    common::build::build_run("quad-edge", model, size, out, extra)
+}
+
+/// Build options of the quad-edge scheme, to adjust before `resolve`.
+fn quad_options(size: &str, holes: u32, out: &Path) -> BuildOptions {
+    common::build::options(SchemeName::QuadEdge, size, holes, out)
+}
+
+/// The library-level twin of `unfold MODEL --scheme quad-edge --size SIZE --holes H
+/// [--hole-diameter D] [--samples N]`.
+fn quad_job(
+    model: &Path,
+    size: &str,
+    holes: u32,
+    hole_diameter: Option<&str>,
+    samples: Option<u32>,
+) -> Job {
+    let mut options = quad_options(size, holes, Path::new("unused"));
+    options.hole_diameter = hole_diameter.map(str::to_string);
+    options.samples = samples;
+    resolve(options, model)
+}
+
+/// Σ face degrees of a mesh (its face corners).
+fn face_corners(mesh: &Mesh) -> usize {
+    mesh.faces().map(|f| mesh.face_degree(f)).sum()
+}
+
+/// The edge a panel was made from.
+fn edge_of(p: &FlatPanel) -> EdgeId {
+    match p.source {
+        Source::Edge(e) => EdgeId(e),
+        other => panic!("{}: a quad-edge panel made from {other:?}", p.id),
+    }
+}
+
+/// Average of a face's corners (the spec's face centre c), computed here.
+fn centre(mesh: &Mesh, f: FaceId) -> DVec3 {
+    let corners: Vec<DVec3> = mesh.face_positions(f).collect();
+    corners.iter().copied().sum::<DVec3>() / corners.len() as f64
+}
+
+/// Unit normal of a (planar) face from its corners (Newell).
+fn normal(mesh: &Mesh, f: FaceId) -> DVec3 {
+    let corners: Vec<DVec3> = mesh.face_positions(f).collect();
+    let n = corners.len();
+    (0..n)
+        .map(|i| corners[i].cross(corners[(i + 1) % n]))
+        .sum::<DVec3>()
+        .normalize()
+}
+
+/// The spec's face band corner of vertex position `v` in face `f`: `s·v + (1−s)·c`.
+fn band_corner(mesh: &Mesh, f: FaceId, v: DVec3, s: f64) -> DVec3 {
+    s * v + (1.0 - s) * centre(mesh, f)
+}
+
+/// Largest distance between two of the points.
+fn diameter<T: Copy>(points: &[T], dist: impl Fn(T, T) -> f64) -> f64 {
+    let mut best = 0.0f64;
+    for (i, &a) in points.iter().enumerate() {
+        for &b in &points[i + 1..] {
+            best = best.max(dist(a, b));
+        }
+    }
+    best
+}
+
+fn signed_area(poly: &[DVec2]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| poly[i].perp_dot(poly[(i + 1) % n]))
+        .sum::<f64>()
+        * 0.5
+}
+
+fn point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    p.distance(a + t * (b - a))
+}
+
+/// Distance between two segments (0 when they cross).
+fn segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
+    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let (o1, o2) = (orient(a, b, c), orient(a, b, d));
+    let (o3, o4) = (orient(c, d, a), orient(c, d, b));
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return 0.0;
+    }
+    point_segment(a, c, d)
+        .min(point_segment(b, c, d))
+        .min(point_segment(c, a, b))
+        .min(point_segment(d, a, b))
+}
+
+/// Why a closed polygon is not simple (edges that are not neighbours closer than `eps`,
+/// or neighbours folding back onto each other), or `None`.
+fn not_simple(poly: &[DVec2], eps: f64) -> Option<String> {
+    let n = poly.len();
+    if n < 3 {
+        return Some(format!("{n} corners"));
+    }
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        // The neighbour after: its far end must not lie on this edge, nor this edge's
+        // start on it.
+        let c = poly[(i + 2) % n];
+        if n > 3 && (point_segment(c, a, b) < eps || point_segment(a, b, c) < eps) {
+            return Some(format!("edges {i} and {} fold back at {b}", (i + 1) % n));
+        }
+        for j in i + 2..n {
+            if i == 0 && j == n - 1 {
+                continue;
+            }
+            let (c, d) = (poly[j], poly[(j + 1) % n]);
+            let gap = segment_distance(a, b, c, d);
+            if gap < eps {
+                return Some(format!(
+                    "edges {i} ({a} → {b}) and {j} ({c} → {d}) meet (gap {gap:e})"
+                ));
+            }
+        }
+    }
+    None
+}
+
+/// The rulings of an interior-edge panel with `n` strips: the vertex pairs shared by
+/// facets k and k + 1, k = 0..=n (flap | strip 1 | … | strip n | flap).
+fn rulings(panel: &Panel, n: usize) -> Vec<[u32; 2]> {
+    (0..=n)
+        .map(|k| {
+            let next: BTreeSet<u32> = panel.facets[k + 1].iter().copied().collect();
+            let shared: Vec<u32> = panel.facets[k]
+                .iter()
+                .copied()
+                .filter(|i| next.contains(i))
+                .collect();
+            assert_eq!(
+                shared.len(),
+                2,
+                "{}: facets {k} and {} share {shared:?}, not one edge",
+                panel.id,
+                k + 1
+            );
+            [shared[0], shared[1]]
+        })
+        .collect()
+}
+
+/// Quadratic Bézier point, written here.
+fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
+    (1.0 - t) * (1.0 - t) * p0 + 2.0 * (1.0 - t) * t * p1 + t * t * p2
+}
+
+// =======================================================================================
+// Facts checked on the flat panels of every model
+// =======================================================================================
+
+/// Every panel comes from its own edge (all edges once), the connections are the face
+/// corners, interior-edge panels have `samples + 2` facets and boundary-edge panels one;
+/// every flat outline is simple and counter-clockwise (outside up) and the facets tile it
+/// (Σ facet areas = outline area, each facet counter-clockwise): no panel overlaps
+/// itself.
+fn check_panels(p: &Pipeline, job: &Job, what: &str) {
+    let mesh = &p.mesh;
+    let n = job.scheme_options.samples as usize;
+    assert_eq!(
+        p.flat.len(),
+        mesh.edge_count(),
+        "{what}: one panel per edge"
+    );
+    let edges: BTreeSet<u32> = p.flat.iter().map(|fp| edge_of(fp).0).collect();
+    assert_eq!(
+        edges,
+        (0..mesh.edge_count() as u32).collect(),
+        "{what}: every edge has its panel"
+    );
+    assert_eq!(
+        p.output.connections,
+        face_corners(mesh),
+        "{what}: connections = face corners"
+    );
+    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+        let e = edge_of(fp);
+        assert_eq!(fp.id, format!("E{}", e.0), "{what}: panel id");
+        let facets = if mesh.is_boundary_edge(e) { 1 } else { n + 2 };
+        assert_eq!(
+            panel.facets.len(),
+            facets,
+            "{what}: {} ({}) has {} facets",
+            fp.id,
+            if facets == 1 {
+                "boundary edge"
+            } else {
+                "interior edge"
+            },
+            panel.facets.len()
+        );
+        assert_eq!(fp.outline.len(), 1, "{what}: {} has inner cuts", fp.id);
+        let outer = fp.outer();
+        let size = diameter(&outer, DVec2::distance);
+        if let Some(why) = not_simple(&outer, 1e-9 * size) {
+            panic!("{what}: panel {} overlaps itself: {why}", fp.id);
+        }
+        let area = signed_area(&outer);
+        assert!(area > 0.0, "{what}: {} is laid face down", fp.id);
+        let mut facets_area = 0.0;
+        for (k, facet) in fp.facets.iter().enumerate() {
+            let a = signed_area(&fp.loop_points(facet));
+            assert!(a > 0.0, "{what}: {} facet {k} is flipped ({a} mm²)", fp.id);
+            facets_area += a;
+        }
+        assert!(
+            (facets_area - area).abs() <= 1e-9 * area,
+            "{what}: {} facets cover {facets_area} mm² of a {area} mm² outline: they overlap",
+            fp.id
+        );
+    }
+}
+
+/// Unrolling keeps every facet edge length, to `rel` of the panel's size (computed here
+/// from the 3D and the flat corners); the flattener's own figure agrees. Returns the
+/// worst relative error.
+fn check_developable(p: &Pipeline, what: &str, rel: f64) -> f64 {
+    let mut worst = 0.0f64;
+    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+        let size = diameter(&fp.outer(), DVec2::distance);
+        let mut error = 0.0f64;
+        for facet in &panel.facets {
+            for k in 0..facet.len() {
+                let (i, j) = (facet[k] as usize, facet[(k + 1) % facet.len()] as usize);
+                let d3 = panel.vertices[i].distance(panel.vertices[j]);
+                let d2 = fp.points[i].distance(fp.points[j]);
+                error = error.max((d3 - d2).abs());
+            }
+        }
+        assert!(
+            error <= rel * size && fp.developability_error <= rel * size,
+            "{what}: {} changes a facet edge by {error:e} mm (flattener says {:e}) on a {size} mm panel",
+            fp.id,
+            fp.developability_error
+        );
+        worst = worst.max(error / size);
+    }
+    worst
+}
+
+/// The bend of every interior-edge panel (SPEC §2): facets 1..=n are quads whose corners
+/// are coplanar (each corner within 1e-9 of the strip's size of the plane through the
+/// other three); the n + 1 rulings (the edges shared by consecutive facets) are parallel
+/// to the mesh edge in 3D (|û × ê| < 1e-9) and to each other in the flat panel, and sit
+/// on the rails `f-band(v) → b·v + (1−b)·m → f′-band(v)` (same at v′) at `t = k/n`
+/// (within 1e-9 of the model size); the score lines are rulings. Flaps: on a planar
+/// model each flap lies in the plane of its face, inside the face band, between the band
+/// edge and the inner line (band corners moved F toward c), with every corner that is
+/// not a band corner on the inner line. A boundary-edge panel is one flap on its face's
+/// band edge.
+fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) {
+    let mesh = &p.mesh;
+    let o = &job.scheme_options;
+    let n = o.samples as usize;
+    let tol = 1e-9 * size_mm;
+    let mut strips = 0;
+    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+        let e = edge_of(fp);
+        let h = e.half_edge();
+        let at = |i: u32| panel.vertices[i as usize];
+        let (v, w) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
+        let along = (w - v).normalize();
+
+        // The faces and the flap facet lying in each.
+        let mut flaps: Vec<(FaceId, HalfEdgeId, usize)> = Vec::new();
+        if mesh.is_boundary_edge(e) {
+            let h = if mesh.face(h).is_some() { h } else { h.twin() };
+            flaps.push((mesh.face(h).unwrap(), h, 0));
+        } else {
+            let (f, g) = (mesh.face(h).unwrap(), mesh.face(h.twin()).unwrap());
+            let s = o.face_scale;
+            let b = o.bridge_scale;
+            let m = 0.5 * (v + w);
+            let rail = |t: f64| {
+                [
+                    bezier(
+                        band_corner(mesh, f, v, s),
+                        b * v + (1.0 - b) * m,
+                        band_corner(mesh, g, v, s),
+                        t,
+                    ),
+                    bezier(
+                        band_corner(mesh, f, w, s),
+                        b * w + (1.0 - b) * m,
+                        band_corner(mesh, g, w, s),
+                        t,
+                    ),
+                ]
+            };
+            assert_eq!(
+                panel.facets.len(),
+                n + 2,
+                "{what}: {} is not flap + {n} strips + flap",
+                fp.id
+            );
+            let lines = rulings(panel, n);
+            // Facet 0 is the flap in f or in g: the rulings run from that face's band
+            // edge to the other's.
+            let matches = |k: usize, t: f64| {
+                let [a, b] = lines[k];
+                let [rv, rw] = rail(t);
+                (at(a).distance(rv) <= tol && at(b).distance(rw) <= tol)
+                    || (at(a).distance(rw) <= tol && at(b).distance(rv) <= tol)
+            };
+            let forward = (0..=n).all(|k| matches(k, k as f64 / n as f64));
+            let backward = (0..=n).all(|k| matches(k, 1.0 - k as f64 / n as f64));
+            assert!(
+                forward || backward,
+                "{what}: {}: rulings {:?} are not on the rails of the spec at t = k/{n}",
+                fp.id,
+                lines
+                    .iter()
+                    .map(|[a, b]| (at(*a), at(*b)))
+                    .collect::<Vec<_>>()
+            );
+            let (first, last) = if forward { (f, g) } else { (g, f) };
+            let he = |face: FaceId| {
+                if mesh.face(h) == Some(face) {
+                    h
+                } else {
+                    h.twin()
+                }
+            };
+            flaps.push((first, he(first), 0));
+            flaps.push((last, he(last), n + 1));
+
+            for (k, [a, b]) in lines.iter().enumerate() {
+                let ruling = at(*b) - at(*a);
+                let cross = ruling.normalize().cross(along).length();
+                assert!(
+                    cross < 1e-9,
+                    "{what}: {} ruling {k} is not parallel to edge {} (|û × ê| = {cross:e})",
+                    fp.id,
+                    e.0
+                );
+                let flat_first = fp.points[lines[0][1] as usize] - fp.points[lines[0][0] as usize];
+                let flat = fp.points[*b as usize] - fp.points[*a as usize];
+                let cross2 = flat.normalize().perp_dot(flat_first.normalize()).abs();
+                assert!(
+                    cross2 < 1e-9,
+                    "{what}: {} flat ruling {k} is not parallel to ruling 0 ({cross2:e})",
+                    fp.id
+                );
+            }
+            let ruling_set: BTreeSet<(u32, u32)> =
+                lines.iter().map(|[a, b]| (*a.min(b), *a.max(b))).collect();
+            for [a, b] in &fp.scores {
+                assert!(
+                    ruling_set.contains(&(*a.min(b), *a.max(b))),
+                    "{what}: {} scores {a}-{b}, which is not a ruling",
+                    fp.id
+                );
+            }
+            for k in 1..=n {
+                let q: Vec<DVec3> = panel.facets[k].iter().map(|&i| at(i)).collect();
+                assert_eq!(q.len(), 4, "{what}: {} strip {k} is not a quad", fp.id);
+                let size = diameter(&q, DVec3::distance);
+                for i in 0..4 {
+                    let (a, b, c) = (q[(i + 1) % 4], q[(i + 2) % 4], q[(i + 3) % 4]);
+                    let nrm = (b - a).cross(c - a).normalize();
+                    let off = (q[i] - a).dot(nrm).abs();
+                    assert!(
+                        off <= 1e-9 * size,
+                        "{what}: {} strip {k} is not planar: corner {i} is {off:e} mm off the plane of the others (strip size {size} mm)",
+                        fp.id
+                    );
+                }
+                strips += 1;
+            }
+        }
+
+        // Flaps, on planar faces: in the face plane, inside its band, between the band
+        // edge and the inner line.
+        if !planar {
+            continue;
+        }
+        for (face, he, facet) in flaps {
+            let c = centre(mesh, face);
+            let nrm = normal(mesh, face);
+            let band: Vec<DVec3> = mesh
+                .face_positions(face)
+                .map(|p| band_corner(mesh, face, p, o.face_scale))
+                .collect();
+            let ex = (band[1] - band[0]).normalize();
+            let ey = nrm.cross(ex);
+            let to2 = |p: DVec3| DVec2::new((p - c).dot(ex), (p - c).dot(ey));
+            let band2: Vec<DVec2> = band.iter().map(|&p| to2(p)).collect();
+            let (bv, bw) = (
+                band_corner(mesh, face, mesh.position(mesh.origin(he)), o.face_scale),
+                band_corner(mesh, face, mesh.position(mesh.dest(he)), o.face_scale),
+            );
+            let lerp = |p: DVec3| p + o.flap_scale * (c - p);
+            let (iv, iw) = (to2(lerp(bv)), to2(lerp(bw)));
+            let corners: Vec<DVec3> = panel.facets[facet].iter().map(|&i| at(i)).collect();
+            for (k, &q) in corners.iter().enumerate() {
+                let off = (q - c).dot(nrm).abs();
+                assert!(
+                    off <= tol,
+                    "{what}: {} flap {facet} corner {k} is {off:e} mm off its face's plane",
+                    fp.id
+                );
+                let q2 = to2(q);
+                assert!(
+                    inside(&band2, q2) || distance_to_border(&band2, q2) <= tol,
+                    "{what}: {} flap {facet} corner {k} leaves the face band",
+                    fp.id
+                );
+                let is_band_corner = band.iter().any(|&b| b.distance(q) <= tol);
+                // Signed distance from the inner line, positive toward the band edge.
+                let side = (iw - iv).normalize().perp_dot(q2 - iv);
+                let edge_side = (iw - iv).normalize().perp_dot(to2(bv) - iv);
+                assert!(
+                    side * edge_side.signum() >= -tol,
+                    "{what}: {} flap {facet} corner {k} is beyond the inner line",
+                    fp.id
+                );
+                if !is_band_corner {
+                    assert!(
+                        side.abs() <= tol,
+                        "{what}: {} flap {facet} corner {k} is neither a band corner nor on the inner line ({side:e} mm off)",
+                        fp.id
+                    );
+                }
+            }
+            // The flap starts on the band edge of its edge.
+            for b in [bv, bw] {
+                assert!(
+                    corners.iter().any(|&q| q.distance(b) <= tol),
+                    "{what}: {} flap {facet} misses band corner {b}",
+                    fp.id
+                );
+            }
+        }
+    }
+    let interior = mesh.edges().filter(|&e| !mesh.is_boundary_edge(e)).count();
+    assert_eq!(strips, n * interior, "{what}: strips checked");
+}
+
+/// What [`check_holes`] found.
+struct HoleFacts {
+    /// Holes on all panels.
+    holes: usize,
+    /// Connections with holes.
+    with_holes: usize,
+    /// Connections with fewer holes than wanted (possibly none).
+    fewer: usize,
+    /// Connections without holes.
+    none: usize,
+    /// Largest 3D distance between partner holes (mm).
+    worst_apart: f64,
+}
+
+/// How close partner holes must be once unrolled and mapped back to 3D.
+#[derive(Clone, Copy, PartialEq)]
+enum Pairing {
+    /// Within `rel_tol` × model size.
+    Strict,
+    /// Within `rel_tol` × model size + `--planarity-tol` × the face's diameter: on a
+    /// face planar only within the tolerance a flap is not planar (its band corners are
+    /// off the face's plane, its inner corners on it), so its unrolling is not an
+    /// isometry and the holes move (see the ignored test at the end of this file).
+    WithinPlanarity,
+}
+
+/// Follows every flat hole back to 3D through its facet's frame. Every connection id is
+/// a face corner (a half-edge with a face); its holes are on exactly two panels, the
+/// panels of the two edges meeting at that corner (the half-edge's own edge and its
+/// predecessor's), the same number on each (1, 2 or 4, at most `--holes`; exactly that
+/// when `all`), at identical 3D points on both panels (within 1e-9 of the size) and,
+/// unrolled and mapped back through the facet's frame (which lands on the projection of
+/// the 3D point onto the facet's plane), pairing up at the same 3D point as `pairing`
+/// says; they lie in the face's plane, nearest to that corner's band corner, on a flap
+/// (never a strip)
+/// with one diameter of material to the flap's border; the holes of one connection on
+/// one panel are at least two diameters apart (one diameter of material between them)
+/// and no two holes of a panel overlap (in the plane, within `rel_tol` × model size).
+fn check_holes(
+    p: &Pipeline,
+    job: &Job,
+    what: &str,
+    size_mm: f64,
+    rel_tol: f64,
+    pairing: Pairing,
+    all: bool,
+) -> HoleFacts {
+    let mesh = &p.mesh;
+    let o = &job.scheme_options;
+    let wanted = o.holes as usize;
+    let d = o.hole_diameter;
+    let r = 0.5 * d;
+    let tol = rel_tol * size_mm;
+    let n = o.samples as usize;
+    let exact = 1e-9 * size_mm;
+
+    // connection → [(panel index, unrolled point mapped back to 3D, the 3D hole)]
+    let mut by_connection: BTreeMap<u32, Vec<(usize, DVec3, DVec3)>> = BTreeMap::new();
+    let mut holes = 0;
+    for (k, fp) in p.flat.iter().enumerate() {
+        assert_eq!(
+            fp.holes.len(),
+            p.output.panels[k].holes.len(),
+            "{what}: {}",
+            fp.id
+        );
+        let panel = &p.output.panels[k];
+        let last = panel.facets.len() - 1;
+        for (hole, hole3) in fp.holes.iter().zip(&panel.holes) {
+            holes += 1;
+            assert_eq!(
+                (hole.connection, hole.facet),
+                (hole3.connection, hole3.facet),
+                "{what}: {} holes out of order",
+                fp.id
+            );
+            assert!(
+                (hole.diameter - d).abs() < 1e-12,
+                "{what}: {} hole diameter {}",
+                fp.id,
+                hole.diameter
+            );
+            assert!(
+                hole.facet == 0 || hole.facet as usize == last,
+                "{what}: {} hole of connection {} on facet {} (a strip of its {n})",
+                fp.id,
+                hole.connection,
+                hole.facet
+            );
+            let facet = fp.loop_points(&fp.facets[hole.facet as usize]);
+            assert!(
+                inside(&facet, hole.center),
+                "{what}: {} hole of connection {} outside its flap",
+                fp.id,
+                hole.connection
+            );
+            let clear = distance_to_border(&facet, hole.center);
+            assert!(
+                clear >= r + d - tol,
+                "{what}: {} hole of connection {} is {clear} mm from its flap's border: radius {r} + one diameter {d} wanted",
+                fp.id,
+                hole.connection
+            );
+            let frame = fp.frames[hole.facet as usize];
+            let point = frame.to_3d(hole.center);
+            let normal = frame.x3.cross(frame.y3);
+            let foot = hole3.position - (hole3.position - frame.origin3).dot(normal) * normal;
+            assert!(
+                point.distance(foot) <= exact,
+                "{what}: {} hole of connection {} unrolls to {point}, not onto its 3D point {} projected on the facet ({foot})",
+                fp.id,
+                hole.connection,
+                hole3.position
+            );
+            by_connection
+                .entry(hole.connection)
+                .or_default()
+                .push((k, point, hole3.position));
+        }
+        for (i, a) in fp.holes.iter().enumerate() {
+            for b in &fp.holes[i + 1..] {
+                let gap = a.center.distance(b.center);
+                assert!(
+                    gap > d,
+                    "{what}: {} holes of connections {} and {} overlap ({gap} mm apart)",
+                    fp.id,
+                    a.connection,
+                    b.connection
+                );
+                if a.connection == b.connection {
+                    assert!(
+                        gap >= 2.0 * d - tol,
+                        "{what}: {} holes of connection {} are {gap} mm apart, less than two diameters",
+                        fp.id,
+                        a.connection
+                    );
+                }
+            }
+        }
+    }
+
+    let mut worst_apart = 0.0f64;
+    let mut fewer = 0;
+    for (&c, list) in &by_connection {
+        let h = HalfEdgeId(c);
+        assert!(
+            h.index() < mesh.half_edge_count(),
+            "{what}: connection {c} is no half-edge"
+        );
+        let f = mesh
+            .face(h)
+            .unwrap_or_else(|| panic!("{what}: connection {c} is a boundary half-edge"));
+        let want: BTreeSet<u32> = [h.edge().0, mesh.prev(h).edge().0].into();
+        let owners: BTreeSet<usize> = list.iter().map(|x| x.0).collect();
+        let sources: BTreeSet<u32> = owners.iter().map(|&k| edge_of(&p.flat[k]).0).collect();
+        assert_eq!(
+            (owners.len(), &sources),
+            (2, &want),
+            "{what}: connection {c} (corner of face {} at vertex {}) has holes on panels {sources:?}, want the panels of edges {want:?}",
+            f.0,
+            mesh.origin(h).0
+        );
+        let [a, b]: [usize; 2] = owners.into_iter().collect::<Vec<_>>().try_into().unwrap();
+        let on_a: Vec<(DVec3, DVec3)> = list
+            .iter()
+            .filter(|x| x.0 == a)
+            .map(|x| (x.1, x.2))
+            .collect();
+        let on_b: Vec<(DVec3, DVec3)> = list
+            .iter()
+            .filter(|x| x.0 == b)
+            .map(|x| (x.1, x.2))
+            .collect();
+        assert_eq!(
+            on_a.len(),
+            on_b.len(),
+            "{what}: connection {c}: {} and {} holes on its two panels",
+            on_a.len(),
+            on_b.len()
+        );
+        let per = on_a.len();
+        assert!(
+            [1, 2, 4].contains(&per) && per <= wanted,
+            "{what}: connection {c} has {per} holes per panel, --holes {wanted}"
+        );
+        if all {
+            assert_eq!(per, wanted, "{what}: connection {c} has {per} holes");
+        }
+        if per < wanted {
+            fewer += 1;
+        }
+        // Pair them in 3D: the unrolled holes mapped back, and the scheme's 3D holes.
+        let pair_tol = match pairing {
+            Pairing::Strict => tol,
+            Pairing::WithinPlanarity => {
+                let corners: Vec<DVec3> = mesh.face_positions(f).collect();
+                tol + job.model.planarity_tol * diameter(&corners, DVec3::distance)
+            }
+        };
+        let mut matched = BTreeSet::new();
+        for (qa, pa) in &on_a {
+            let (nearest, j) = on_b
+                .iter()
+                .enumerate()
+                .map(|(j, (qb, _))| (qa.distance(*qb), j))
+                .min_by(|x, y| x.0.total_cmp(&y.0))
+                .unwrap();
+            assert!(
+                nearest <= pair_tol,
+                "{what}: connection {c}: hole of {} at {qa} has no partner on {} (nearest {nearest:e} mm, tolerance {pair_tol:e})",
+                p.flat[a].id,
+                p.flat[b].id
+            );
+            assert!(
+                matched.insert(j),
+                "{what}: connection {c}: two holes share one partner"
+            );
+            let apart3 = pa.distance(on_b[j].1);
+            assert!(
+                apart3 <= exact,
+                "{what}: connection {c}: the 3D holes of partners are {apart3:e} mm apart"
+            );
+            worst_apart = worst_apart.max(nearest);
+        }
+        // In the corner's face, inside the overlap of the two flaps meeting there (the
+        // face band, cut by the inner lines of the corner's two band edges), with one
+        // diameter of material to its border.
+        let cf = centre(mesh, f);
+        let nf = normal(mesh, f);
+        let ex = (mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h))).normalize();
+        let ey = nf.cross(ex);
+        let to2 = |q: DVec3| DVec2::new((q - cf).dot(ex), (q - cf).dot(ey));
+        let band: Vec<DVec2> = mesh
+            .face_positions(f)
+            .map(|v| to2(band_corner(mesh, f, v, o.face_scale)))
+            .collect();
+        // Signed distance from the inner line of the band edge of half-edge `g`,
+        // positive on the band edge's side.
+        let inner = |g: HalfEdgeId, q: DVec2| {
+            let (bv, bw) = (
+                to2(band_corner(
+                    mesh,
+                    f,
+                    mesh.position(mesh.origin(g)),
+                    o.face_scale,
+                )),
+                to2(band_corner(
+                    mesh,
+                    f,
+                    mesh.position(mesh.dest(g)),
+                    o.face_scale,
+                )),
+            );
+            let (iv, iw) = (bv * (1.0 - o.flap_scale), bw * (1.0 - o.flap_scale));
+            let u = (iw - iv).normalize();
+            let side = u.perp_dot(q - iv);
+            side * u.perp_dot(bv - iv).signum()
+        };
+        for (_, q) in on_a.iter().chain(&on_b) {
+            let off = (*q - cf).dot(nf).abs();
+            assert!(
+                off <= exact,
+                "{what}: connection {c}: hole {off:e} mm off the plane of face {}",
+                f.0
+            );
+            let q2 = to2(*q);
+            let clear = if inside(&band, q2) {
+                distance_to_border(&band, q2)
+            } else {
+                -distance_to_border(&band, q2)
+            }
+            .min(inner(h, q2))
+            .min(inner(mesh.prev(h), q2));
+            assert!(
+                clear >= r + d - tol,
+                "{what}: connection {c}: a hole is {clear} mm inside the overlap of the flaps at corner {} of face {}, radius {r} + one diameter {d} wanted",
+                mesh.origin(h).0,
+                f.0
+            );
+        }
+    }
+
+    let corners: BTreeSet<u32> = mesh
+        .half_edges()
+        .filter(|&h| mesh.face(h).is_some())
+        .map(|h| h.0)
+        .collect();
+    assert_eq!(corners.len(), p.output.connections, "{what}: connections");
+    if all {
+        assert_eq!(
+            by_connection.keys().copied().collect::<BTreeSet<_>>(),
+            corners,
+            "{what}: every face corner has its holes"
+        );
+        assert_eq!(
+            holes,
+            2 * wanted * p.output.connections,
+            "{what}: 2 × --holes × connections"
+        );
+    }
+    let with_holes = by_connection.len();
+    HoleFacts {
+        holes,
+        with_holes,
+        fewer: fewer + (p.output.connections - with_holes),
+        none: p.output.connections - with_holes,
+        worst_apart,
+    }
+}
+
+/// The scheme's note "X of Y connections have fewer than N fastener holes (Z have none)"
+/// as (X, Y, N, Z), if the report has it.
+fn fewer_holes_note(report: &str) -> Option<(usize, usize, usize, usize)> {
+    let line = report
+        .lines()
+        .find(|l| l.contains(" connections have fewer than "))?;
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = |w: &str| words.iter().position(|x| *x == w);
+    let number = |i: usize| -> usize {
+        words[i]
+            .trim_matches(|c: char| !c.is_ascii_digit())
+            .parse()
+            .unwrap_or_else(|_| panic!("a number in {line:?}: {}", words[i]))
+    };
+    let of = at("of")?;
+    let than = at("than")?;
+    let none = at("none):")?;
+    Some((
+        number(of - 1),
+        number(of + 1),
+        number(than + 1),
+        number(none - 2),
+    ))
+}
+
+/// The same holes in the files: `counts.holes` and `counts.connections` of a binary
+/// run with the same options equal the library's; the SVG circles (checker's stats)
+/// number `counts.holes`, each of radius d/2; the report's note on connections with
+/// fewer holes than wanted gives the same figures, and is absent when every connection
+/// has them all.
+fn check_holes_in_files(
+    facts: &HoleFacts,
+    p: &Pipeline,
+    job: &Job,
+    model: &Path,
+    size: &str,
+    extra: &[&str],
+    what: &str,
+) {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let holes = job.scheme_options.holes.to_string();
+    let mut args = vec!["--holes", &holes, "--format", "svg"];
+    args.extend_from_slice(extra);
+    let (m, run) = build_run(model, size, &out, &args);
+    assert_eq!(
+        count(&m, "counts.holes"),
+        facts.holes,
+        "{what}: counts.holes"
+    );
+    assert_eq!(
+        count(&m, "counts.connections"),
+        p.output.connections,
+        "{what}: counts.connections"
+    );
+    let sheets = check_sheets(&out, &m, DxfCheck::All);
+    assert_eq!(
+        sheets.total().holes,
+        facts.holes,
+        "{what}: circles on the sheets"
+    );
+    let r = 0.5 * job.scheme_options.hole_diameter;
+    for file in &sheets.svg_files {
+        let text = std::fs::read_to_string(out.join(file)).unwrap();
+        for (layer, _, _, radius) in svg_circles(&text) {
+            assert_eq!(layer, "CUT", "{what}: {file}: a circle on {layer}");
+            assert!(
+                (radius - r).abs() <= 1e-4,
+                "{what}: {file}: hole radius {radius}, want {r}"
+            );
+        }
+    }
+    match fewer_holes_note(&run.stderr) {
+        None => assert_eq!(
+            facts.fewer, 0,
+            "{what}: {} connections have fewer holes than wanted and the report does not say so:\n{}",
+            facts.fewer, run.stderr
+        ),
+        Some((fewer, of, wanted, none)) => assert_eq!(
+            (fewer, of, wanted, none),
+            (
+                facts.fewer,
+                p.output.connections,
+                job.scheme_options.holes as usize,
+                facts.none
+            ),
+            "{what}: the report's note on holes: {}",
+            run.stderr
+        ),
+    }
+}
+
+// =======================================================================================
+// 1. Panels and connections: E panels, 2E connections on closed meshes
+// =======================================================================================
+
+/// Builds a model with `--sheet 18x24in --format svg,dxf EXTRA…`, checks its output
+/// folder (every sheet through the checker, DXF as `dxf` says, manifest against the
+/// sheets, panel ids `E<edge>`) and the counts against the library's mesh: panels = E =
+/// input.edges, each edge once; connections = Σ face degrees (= 2E when closed); the
+/// manifest's developability error per panel below 1e-9 of the panel's size when the
+/// model is planar. Returns the manifest, the report, the pipeline and its job.
+fn check_model(
+    model: &Path,
+    size: &str,
+    extra: &[&str],
+    dxf: DxfCheck,
+    planar: bool,
+) -> (Value, String, Pipeline, Job) {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let what = format!("{} at {size} (quad-edge)", model.display());
+    let mut args = vec!["--sheet", "18x24in", "--format", "svg,dxf"];
+    args.extend_from_slice(extra);
+    let (m, run) = build_run(model, size, &out, &args);
+    assert_eq!(m["scheme"]["name"], "quad-edge", "{what}");
+    check_output(model, &out, &m, &what, dxf, |p| {
+        format!("E{}", count(p, "source.edge"))
+    });
+
+    let mut options = quad_options(size, 2, &out);
+    if let Some(i) = extra.iter().position(|a| *a == "--hole-diameter") {
+        options.hole_diameter = Some(extra[i + 1].to_string());
+    }
+    let job = resolve(options, model);
+    let p = pipeline(&job);
+    let edges = count(&m, "input.edges");
+    assert_eq!(edges, p.mesh.edge_count(), "{what}: input.edges");
+    assert_eq!(
+        count(&m, "input.faces"),
+        p.mesh.face_count(),
+        "{what}: input.faces"
+    );
+    assert_eq!(count(&m, "counts.panels"), edges, "{what}: panels = E");
+    let list = m["panels"].as_array().unwrap();
+    let sources: BTreeSet<usize> = list.iter().map(|p| count(p, "source.edge")).collect();
+    assert_eq!(
+        sources,
+        (0..edges).collect(),
+        "{what}: one panel per edge, from every edge"
+    );
+    let connections = count(&m, "counts.connections");
+    assert_eq!(
+        connections,
+        face_corners(&p.mesh),
+        "{what}: connections = Σ face degrees"
+    );
+    assert_eq!(connections, p.output.connections, "{what}: connections");
+    if count(&m, "input.boundary_loops") == 0 {
+        assert_eq!(connections, 2 * edges, "{what}: closed: connections = 2E");
+    }
+    let split =
+        count(&m, "input.faces_split.non_planar") + count(&m, "input.faces_split.not_star_shaped");
+    if split == 0 {
+        // The file's own faces, counted without the tool.
+        let (_, faces) = read_simple_obj(model);
+        let degrees: usize = faces.iter().map(Vec::len).sum();
+        assert_eq!(
+            connections, degrees,
+            "{what}: Σ degrees of the file's faces"
+        );
+    }
+    check_panels(&p, &job, &what);
+
+    if planar {
+        let max = num(&m, "max_developability_error");
+        let mut largest = 0.0f64;
+        for (entry, fp) in list.iter().zip(&p.flat) {
+            assert_eq!(
+                entry["id"].as_str(),
+                Some(fp.id.as_str()),
+                "{what}: panel order"
+            );
+            let size = diameter(&fp.outer(), DVec2::distance);
+            let e = num(entry, "developability_error");
+            assert!(
+                e <= 1e-9 * size,
+                "{what}: {} developability error {e} mm on a {size} mm panel",
+                fp.id
+            );
+            largest = largest.max(e);
+        }
+        assert_eq!(max, largest, "{what}: max_developability_error");
+    }
+    (m, run.stderr, p, job)
+}
+
+#[test]
+fn closed_meshes_have_a_panel_per_edge_and_two_connections_per_edge() {
+    for name in [
+        "tetrahedron",
+        "hexahedron",
+        "octahedron",
+        "dodecahedron",
+        "icosahedron",
+        "torus-8x6",
+        "genus2",
+        "genus3",
+        "concave",
+    ] {
+        let (m, report, p, _job) = check_model(&model(name), "300mm", &[], DxfCheck::All, true);
+        let what = format!("{name} at 300mm");
+        assert_eq!(count(&m, "input.boundary_loops"), 0, "{what}: closed");
+        assert!(
+            !report.contains("boundary edges"),
+            "{what}: a closed mesh has no boundary panels:\n{report}"
+        );
+        check_developable(&p, &what, 1e-9);
+    }
+}
+
+#[test]
+fn open_meshes_give_boundary_edges_a_single_flap() {
+    for name in ["open-grid", "open-cylinder"] {
+        let path = model(name);
+        let what = format!("{name} at 300mm");
+        let (m, report, p, _job) = check_model(&path, "300mm", &[], DxfCheck::All, true);
+        let facts = inspect_json(&path, &["--size", "300mm"]);
+        let boundary = count(&facts, "mesh.boundary_edges");
+        assert!(boundary > 0, "{what}: an open mesh");
+        assert!(count(&m, "input.boundary_loops") > 0, "{what}");
+        assert_eq!(
+            count(&facts, "mesh.edges"),
+            count(&m, "input.edges"),
+            "{what}"
+        );
+        // The report: "note: B boundary edges have a panel with a single flap and no bend".
+        let line = report
+            .lines()
+            .find(|l| l.contains("boundary edges have a panel with a single flap"))
+            .unwrap_or_else(|| {
+                panic!("{what}: the report does not mention boundary panels:\n{report}")
+            });
+        let said: usize = line
+            .trim_start_matches("note: ")
+            .split_whitespace()
+            .next()
+            .and_then(|w| w.parse().ok())
+            .unwrap_or_else(|| panic!("{what}: no count in {line:?}"));
+        assert_eq!(said, boundary, "{what}: {line}");
+        // The single-flap panels are the boundary edges'.
+        let single: Vec<&FlatPanel> = p.flat.iter().filter(|fp| fp.facets.len() == 1).collect();
+        assert_eq!(single.len(), boundary, "{what}: single-flap panels");
+        for fp in single {
+            assert!(
+                p.mesh.is_boundary_edge(edge_of(fp)),
+                "{what}: {} has one facet but its edge is interior",
+                fp.id
+            );
+            assert!(
+                fp.scores.is_empty(),
+                "{what}: {} has no bend to score",
+                fp.id
+            );
+        }
+        check_developable(&p, &what, 1e-9);
+    }
+}
+
+/// Fertility and horse_quad at 4 ft (1 mm holes, so that some fit: at the default
+/// 1/8 in none does): the counts, every SVG and the first and last DXF, outlines simple,
+/// bends planar with rulings parallel to the edge (their quads are planar only within
+/// --planarity-tol, so the flap checks and the isometry are left to the planar models),
+/// holes of the connections that have them identical in 3D and, unrolled, within 1e-6
+/// of the size plus the planarity tolerance of their face (the ignored test at the end
+/// asks for 1e-6). Prints sheets, lower bound and utilization (holes do not change the
+/// layout).
+#[test]
+fn shared_models_have_a_panel_per_edge_and_paired_holes() {
+    let Some(shared) = shared_models("shared_models_have_a_panel_per_edge_and_paired_holes") else {
+        return;
+    };
+    for name in ["fertility", "horse_quad"] {
+        let path = shared.join(format!("{name}.obj"));
+        let what = format!("{name} at 4ft");
+        let what = what.as_str();
+        let (m, report, p, job) = check_model(
+            &path,
+            "4ft",
+            &["--hole-diameter", "1mm"],
+            DxfCheck::FirstAndLast,
+            false,
+        );
+        assert_eq!(count(&m, "input.boundary_loops"), 0, "{what}: closed");
+        check_bends(&p, &job, what, 1219.2, false);
+        let facts = check_holes(
+            &p,
+            &job,
+            what,
+            1219.2,
+            1e-6,
+            Pairing::WithinPlanarity,
+            false,
+        );
+        assert!(
+            facts.with_holes > 0,
+            "{what}: no connection has room for a 1 mm hole"
+        );
+        assert_eq!(
+            count(&m, "counts.holes"),
+            facts.holes,
+            "{what}: counts.holes"
+        );
+        match fewer_holes_note(&report) {
+            Some(note) => assert_eq!(
+                note,
+                (facts.fewer, p.output.connections, 2, facts.none),
+                "{what}: {report}"
+            ),
+            None => assert_eq!(facts.fewer, 0, "{what}: {report}"),
+        }
+        eprintln!(
+            "{what}: {} of {} connections have holes ({} holes); partner holes at most {:.1e} mm apart",
+            facts.with_holes, p.output.connections, facts.holes, facts.worst_apart
+        );
+        eprintln!(
+            "{name}, quad-edge, 4 ft on 18x24in: {} panels, {} sheets, area lower bound {}, utilization {:.1}%",
+            count(&m, "counts.panels"),
+            count(&m, "counts.sheets"),
+            count(&m, "counts.sheets_lower_bound"),
+            100.0 * num(&m, "utilization")
+        );
+    }
+}
+
+// =======================================================================================
+// 2. Holes of a connection meet in 3D
+// =======================================================================================
+
+/// Library level with `check_holes` (every connection gets all its holes), then the same
+/// options through the binary with `check_holes_in_files`.
+fn holes_everywhere(name: &str, size: &str, size_mm: f64, holes: u32, extra: &[&str]) {
+    let path = model(name);
+    let what = format!(
+        "{name} at {size} --holes {holes}{}",
+        extra.iter().map(|a| format!(" {a}")).collect::<String>()
+    );
+    let diameter = extra
+        .iter()
+        .position(|a| *a == "--hole-diameter")
+        .map(|i| extra[i + 1]);
+    let job = quad_job(&path, size, holes, diameter, None);
+    let p = pipeline(&job);
+    let facts = check_holes(&p, &job, &what, size_mm, 1e-9, Pairing::Strict, true);
+    assert_eq!(facts.with_holes, p.output.connections, "{what}");
+    check_holes_in_files(&facts, &p, &job, &path, size, extra, &what);
+    eprintln!(
+        "{what}: {} holes on {} connections; partner holes at most {:.1e} mm apart",
+        facts.holes, p.output.connections, facts.worst_apart
+    );
+}
+
+#[test]
+fn holes_of_a_connection_meet_in_3d() {
+    // The scheme's note says which sizes have room: the platonic solids at 300 mm do;
+    // genus2 needs 600 mm and genus3 1 mm holes at 300 mm.
+    holes_everywhere("icosahedron", "300mm", 300.0, 2, &[]);
+    holes_everywhere("hexahedron", "300mm", 300.0, 2, &[]);
+    holes_everywhere("genus2", "600mm", 600.0, 2, &[]);
+    holes_everywhere("genus3", "300mm", 300.0, 2, &["--hole-diameter", "1mm"]);
+    holes_everywhere("hexahedron", "300mm", 300.0, 4, &[]);
+    holes_everywhere("icosahedron", "300mm", 300.0, 1, &[]);
+}
+
+/// Where the overlap is too small the scheme places fewer holes (4 → 2 → 1 → 0), still
+/// paired, and says how many connections got fewer.
+#[test]
+fn fewer_holes_where_the_overlap_is_small() {
+    for (name, size, size_mm, holes) in [
+        ("icosahedron", "300mm", 300.0, 4),
+        ("genus3", "600mm", 600.0, 2),
+    ] {
+        let path = model(name);
+        let what = format!("{name} at {size} --holes {holes}");
+        let job = quad_job(&path, size, holes, None, None);
+        let p = pipeline(&job);
+        let facts = check_holes(&p, &job, &what, size_mm, 1e-9, Pairing::Strict, false);
+        assert!(
+            facts.fewer > 0,
+            "{what}: every connection has all its holes"
+        );
+        assert!(facts.with_holes > 0, "{what}: no connection has holes");
+        check_holes_in_files(&facts, &p, &job, &path, size, &[], &what);
+    }
+}
+
+// =======================================================================================
+// 3. Bends: planar strips, rulings parallel to the edge, isometric unrolling
+// =======================================================================================
+
+#[test]
+fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
+    let tmp = TempDir::new().unwrap();
+    for name in [
+        "tetrahedron",
+        "hexahedron",
+        "octahedron",
+        "dodecahedron",
+        "icosahedron",
+        "torus-8x6",
+        "genus2",
+        "genus3",
+        "concave",
+        "open-grid",
+        "open-cylinder",
+    ] {
+        let path = model(name);
+        let job = quad_job(&path, "300mm", 2, None, None);
+        let p = pipeline(&job);
+        let what = format!("{name} at 300mm");
+        check_panels(&p, &job, &what);
+        check_bends(&p, &job, &what, 300.0, true);
+    }
+    // Other sample counts, through the binary too: every ruling of a convex solid folds,
+    // so each panel has n + 1 score lines.
+    for (name, samples) in [
+        ("icosahedron", 1),
+        ("icosahedron", 7),
+        ("genus2", 1),
+        ("genus2", 7),
+    ] {
+        let path = model(name);
+        let what = format!("{name} at 300mm --samples {samples}");
+        let job = quad_job(&path, "300mm", 2, None, Some(samples));
+        let p = pipeline(&job);
+        check_panels(&p, &job, &what);
+        check_bends(&p, &job, &what, 300.0, true);
+        check_developable(&p, &what, 1e-9);
+        let out = tmp.path().join(format!("{name}-{samples}"));
+        let n = samples.to_string();
+        let (m, _) = build_run(&path, "300mm", &out, &["--samples", &n]);
+        assert!(
+            num(&m, "max_developability_error") <= 1e-9 * 300.0,
+            "{what}: max_developability_error {}",
+            m["max_developability_error"]
+        );
+        let sheets = check_sheets(&out, &m, DxfCheck::All);
+        let scores: usize = p.flat.iter().map(|fp| fp.scores.len()).sum();
+        assert_eq!(
+            sheets.total().score_paths,
+            scores,
+            "{what}: score lines drawn"
+        );
+        if name == "icosahedron" {
+            for fp in &p.flat {
+                assert_eq!(fp.scores.len(), samples as usize + 1, "{what}: {}", fp.id);
+            }
+        }
+    }
+}
+
+// =======================================================================================
+// 5. Golden files
+// =======================================================================================
+
+#[test]
+fn golden_files_of_a_small_model() {
+    let golden = crate_dir().join("tests/golden/hexahedron-quad-edge");
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("hexahedron");
+    // A model path relative to the crate root: the manifest's input.path is the same
+    // on every machine.
+    let run = finish(
+        unfold_command()
+            .current_dir(crate_dir())
+            .arg("models/hexahedron.obj")
+            .args(["--size", "150mm", "--scheme", "quad-edge", "--holes", "2"])
+            .args(["--format", "svg,dxf", "--out"])
+            .arg(&out),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let manifest = read_manifest(&out);
+    assert_eq!(manifest["input"]["path"], "models/hexahedron.obj");
+    if compare_with_golden(&out, &golden, tmp.path(), "build_quad_edge") == Golden::Rewritten {
+        return;
+    }
+    // The golden sheets themselves pass the independent check: 12 panels, 2 holes on
+    // each side of each of the 24 corners, 5 score lines (4 strips) per panel.
+    let sheets = check_sheets(&out, &manifest, DxfCheck::All);
+    let total = sheets.total();
+    assert_eq!(total.panels, 12);
+    assert_eq!(count(&manifest, "counts.connections"), 24);
+    assert_eq!(total.holes, 2 * 2 * 24);
+    assert_eq!(total.holes, count(&manifest, "counts.holes"));
+    assert_eq!(total.score_paths, 12 * 5);
+    // Every ruling is a band edge's length: s · 150 mm.
+    assert!((total.score_length - 60.0 * 75.0).abs() < 1e-3);
+}
+
+// =======================================================================================
+// Known bug
+// =======================================================================================
+
+/// A 300 mm cube with one corner lifted 1.5 mm: every face is planar within the default
+/// --planarity-tol (8.8e-4 of its diameter, limit 1e-3), so no face is split. A flap is
+/// one facet whose band corners follow the lifted corner while its inner corners are
+/// put on the face's plane: the facet is not planar, the unroller projects it onto its
+/// own best plane, and the partner holes of a connection (identical in 3D) land up to
+/// 0.19 mm apart once unrolled and mapped back; the developability error is 4.7e-4 mm
+/// (SPEC §3: below 1e-9 of the panel size). On fertility at 4 ft the holes miss by up to
+/// 0.033 mm. Run with `cargo test --test build_quad_edge -- --ignored`.
+#[test]
+#[ignore = "bug: quad-edge flaps on faces planar only within --planarity-tol are not planar facets: unrolled, partner holes miss by 0.19 mm on a 300 mm cube with one corner lifted 1.5 mm; developability error 4.7e-4 mm"]
+fn holes_meet_and_panels_unroll_isometrically_on_nearly_planar_faces() {
+    let tmp = TempDir::new().unwrap();
+    let path = tmp.path().join("bent-cube.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1.005\nv 0 1 1\n\
+         f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n",
+    )
+    .unwrap();
+    let what = "cube with a corner lifted 0.5% at 300mm";
+    let job = quad_job(&path, "300mm", 2, None, None);
+    let p = pipeline(&job);
+    assert_eq!(p.split.count(), 0, "{what}: no face split");
+    check_holes(&p, &job, what, 300.0, 1e-6, Pairing::Strict, true);
+    check_developable(&p, what, 1e-9);
+    if let Some(shared) =
+        shared_models("holes_meet_and_panels_unroll_isometrically_on_nearly_planar_faces")
+    {
+        let job = quad_job(&shared.join("fertility.obj"), "4ft", 2, Some("1mm"), None);
+        let p = pipeline(&job);
+        check_holes(
+            &p,
+            &job,
+            "fertility at 4ft",
+            1219.2,
+            1e-6,
+            Pairing::Strict,
+            false,
+        );
+    }
+}

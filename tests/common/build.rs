@@ -1,0 +1,644 @@
+//! Helpers for the end-to-end build tests of every scheme (`tests/build_*.rs`): running
+//! the binary, reading its manifest, checking every sheet of an output folder with the
+//! independent checker of this module's parent, running the library's pipeline up to the
+//! flat panels the way `src/run.rs` does, golden-file comparison, and a little plane
+//! geometry written here rather than taken from the crate under test.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::ffi::OsStr;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use glam::{DVec2, DVec3};
+use serde_json::Value;
+
+use super::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
+use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
+use unfold::flatten::flatten;
+use unfold::mesh::split::{faces_to_split, split_faces, SplitReport};
+use unfold::mesh::Mesh;
+use unfold::panel::{FlatPanel, Panel};
+use unfold::scheme::{build_panels, needs_convex_faces, SchemeOutput};
+
+// =======================================================================================
+// Paths
+// =======================================================================================
+
+pub fn crate_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A model of the project's own `models/` folder.
+pub fn model(name: &str) -> PathBuf {
+    crate_dir().join("models").join(format!("{name}.obj"))
+}
+
+/// The shared models folder, or `None` (with a message) when this checkout has none.
+pub fn shared_models(test: &str) -> Option<PathBuf> {
+    let dir = crate_dir().join("../shared/models");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!(
+            "{test}: skipping the shared models: {} is absent",
+            dir.display()
+        );
+        None
+    }
+}
+
+// =======================================================================================
+// Running the binary
+// =======================================================================================
+
+/// What one run of the binary did.
+pub struct Run {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+pub fn unfold_command() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_unfold"))
+}
+
+pub fn finish(cmd: &mut Command) -> Run {
+    let output = cmd.output().expect("the unfold binary runs");
+    Run {
+        code: output.status.code(),
+        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
+    }
+}
+
+pub fn unfold<I, S>(args: I) -> Run
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<OsStr>,
+{
+    finish(unfold_command().args(args))
+}
+
+/// Runs `unfold MODEL --scheme SCHEME --size SIZE --out OUT EXTRA…`, asserts success and
+/// returns the parsed `manifest.json` with the run (for its report on stderr).
+pub fn build_run(
+    scheme: &str,
+    model: &Path,
+    size: &str,
+    out: &Path,
+    extra: &[&str],
+) -> (Value, Run) {
+    let mut args: Vec<&OsStr> = vec![
+        model.as_os_str(),
+        OsStr::new("--scheme"),
+        OsStr::new(scheme),
+        OsStr::new("--size"),
+        OsStr::new(size),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ];
+    args.extend(extra.iter().map(OsStr::new));
+    let run = unfold(&args);
+    assert_eq!(run.code, Some(0), "unfold {args:?} failed:\n{}", run.stderr);
+    (read_manifest(out), run)
+}
+
+/// [`build_run`] without the run.
+pub fn build(scheme: &str, model: &Path, size: &str, out: &Path, extra: &[&str]) -> Value {
+    build_run(scheme, model, size, out, extra).0
+}
+
+pub fn read_manifest(out: &Path) -> Value {
+    let text = std::fs::read_to_string(out.join("manifest.json"))
+        .unwrap_or_else(|e| panic!("{}/manifest.json: {e}", out.display()));
+    serde_json::from_str(&text).expect("manifest.json is JSON")
+}
+
+/// `unfold inspect MODEL --json EXTRA…`, parsed.
+pub fn inspect_json(path: &Path, extra: &[&str]) -> Value {
+    let inspect = finish(
+        unfold_command()
+            .arg("inspect")
+            .arg(path)
+            .arg("--json")
+            .args(extra),
+    );
+    assert_eq!(
+        inspect.code,
+        Some(0),
+        "inspect {}: {}",
+        path.display(),
+        inspect.stderr
+    );
+    serde_json::from_str(&inspect.stdout).expect("inspect --json")
+}
+
+// =======================================================================================
+// JSON and files
+// =======================================================================================
+
+/// The value at a dotted path, as a number (panics naming the key otherwise).
+pub fn num(v: &Value, path: &str) -> f64 {
+    let mut cur = v;
+    for key in path.split('.') {
+        cur = &cur[key];
+    }
+    cur.as_f64()
+        .unwrap_or_else(|| panic!("{path} is not a number: {cur}"))
+}
+
+pub fn count(v: &Value, path: &str) -> usize {
+    let mut cur = v;
+    for key in path.split('.') {
+        cur = &cur[key];
+    }
+    cur.as_u64()
+        .unwrap_or_else(|| panic!("{path} is not a count: {cur}")) as usize
+}
+
+/// Every file of a folder (no subfolders expected) with its bytes, by name.
+pub fn folder_files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    let mut files = BTreeMap::new();
+    for entry in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let entry = entry.unwrap();
+        assert!(
+            entry.file_type().unwrap().is_file(),
+            "{} is not a plain file",
+            entry.path().display()
+        );
+        let name = entry.file_name().to_string_lossy().into_owned();
+        files.insert(name, std::fs::read(entry.path()).unwrap());
+    }
+    files
+}
+
+/// Names of the entries of a folder.
+pub fn entry_names(dir: &Path) -> BTreeSet<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect()
+}
+
+pub fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
+}
+
+/// Faces of an OBJ file as written (`f` statements), counted without the tool.
+pub fn obj_face_count(path: &Path) -> usize {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter(|l| l.trim_start().starts_with("f "))
+        .count()
+}
+
+/// Positions and faces (0-based) of a simple OBJ file (`v x y z`, `f a b c…` with
+/// optional `/…` suffixes and positive indices), read without the tool.
+pub fn read_simple_obj(path: &Path) -> (Vec<DVec3>, Vec<Vec<usize>>) {
+    let mut positions = Vec::new();
+    let mut faces = Vec::new();
+    for line in std::fs::read_to_string(path).unwrap().lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let c: Vec<f64> = words.take(3).map(|w| w.parse().unwrap()).collect();
+                positions.push(DVec3::new(c[0], c[1], c[2]));
+            }
+            Some("f") => faces.push(
+                words
+                    .map(|w| w.split('/').next().unwrap().parse::<usize>().unwrap() - 1)
+                    .collect(),
+            ),
+            _ => {}
+        }
+    }
+    (positions, faces)
+}
+
+// =======================================================================================
+// Plane geometry, written here rather than taken from `unfold::plane`
+// =======================================================================================
+
+/// Even-odd point in polygon.
+pub fn inside(poly: &[DVec2], p: DVec2) -> bool {
+    let mut inside = false;
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+pub fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
+    (0..poly.len())
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            p.distance(a + t * (b - a))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+// =======================================================================================
+// Checking the sheets of an output folder
+// =======================================================================================
+
+pub fn sheet_spec(manifest: &Value) -> SheetSpec {
+    SheetSpec {
+        width: num(manifest, "sheet.width"),
+        height: num(manifest, "sheet.height"),
+        margin: num(manifest, "sheet.margin"),
+        spacing: num(manifest, "sheet.spacing"),
+    }
+}
+
+/// Which DXF files of a folder to run through ezdxf.
+#[derive(Clone, Copy, PartialEq)]
+pub enum DxfCheck {
+    /// Every one.
+    All,
+    /// The first and the last sheet (every one with `UNFOLD_FULL_DXF=1`).
+    FirstAndLast,
+}
+
+/// The sheets of an output folder after the independent check.
+pub struct Sheets {
+    /// SVG file names, in order.
+    pub svg_files: Vec<String>,
+    /// Stats of every SVG sheet, in the same order.
+    pub stats: Vec<SheetStats>,
+}
+
+impl Sheets {
+    pub fn total(&self) -> SheetStats {
+        let mut t = SheetStats::default();
+        for s in &self.stats {
+            t.panels += s.panels;
+            t.holes += s.holes;
+            t.cut_paths += s.cut_paths;
+            t.score_paths += s.score_paths;
+            t.engrave_paths += s.engrave_paths;
+            t.panel_area += s.panel_area;
+            t.cut_length += s.cut_length;
+            t.score_length += s.score_length;
+            t.engrave_length += s.engrave_length;
+        }
+        t
+    }
+}
+
+/// Checks every SVG of `out` with `check_svg_sheet` (sheet spec from the manifest) and
+/// the DXF files chosen by `dxf` with `check_dxf_matches_svg` against their SVG.
+pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
+    let spec = sheet_spec(manifest);
+    let names = entry_names(out);
+    let svg_files: Vec<String> = names
+        .iter()
+        .filter(|n| n.ends_with(".svg"))
+        .cloned()
+        .collect();
+    let dxf_files: Vec<String> = names
+        .iter()
+        .filter(|n| n.ends_with(".dxf"))
+        .cloned()
+        .collect();
+    let mut stats = Vec::new();
+    for name in &svg_files {
+        let text = std::fs::read_to_string(out.join(name)).unwrap();
+        let s = check_svg_sheet(&text, &spec)
+            .unwrap_or_else(|e| panic!("{}: sheet check failed:\n{e}", out.join(name).display()));
+        stats.push(s);
+    }
+    for name in &dxf_files {
+        let svg = name.trim_end_matches(".dxf").to_string() + ".svg";
+        assert!(svg_files.contains(&svg), "{name} has no SVG twin");
+    }
+    let full = std::env::var("UNFOLD_FULL_DXF").is_ok_and(|v| v == "1");
+    let chosen: Vec<&String> = if dxf == DxfCheck::All || full || dxf_files.len() <= 2 {
+        dxf_files.iter().collect()
+    } else {
+        vec![&dxf_files[0], &dxf_files[dxf_files.len() - 1]]
+    };
+    // ezdxf runs in child processes: check a few at once.
+    let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let chunk = chosen.len().div_ceil(workers).max(1);
+    let failures: Vec<String> = std::thread::scope(|scope| {
+        let handles: Vec<_> = chosen
+            .chunks(chunk)
+            .map(|names| {
+                scope.spawn(move || {
+                    names
+                        .iter()
+                        .filter_map(|name| {
+                            let svg_name = name.trim_end_matches(".dxf").to_string() + ".svg";
+                            let svg = std::fs::read_to_string(out.join(svg_name)).unwrap();
+                            check_dxf_matches_svg(&out.join(name), &svg, spec.height).err()
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().expect("DXF check thread"))
+            .collect()
+    });
+    assert!(
+        failures.is_empty(),
+        "{} DXF files fail:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+    Sheets { svg_files, stats }
+}
+
+/// Checks the output folder of a run with `--format svg,dxf` against its manifest:
+/// exactly one SVG and one DXF per sheet plus the manifest and the assembled model;
+/// every sheet through the independent checker ([`check_sheets`]); the panels, holes,
+/// panel area and cut/score/engrave lengths on the sheets equal the manifest's; the
+/// manifest's sheet list names the files and their panel counts; its panel list has
+/// one entry per panel with the id `panel_id(entry)` (unique), on the sheet that holds
+/// it, areas adding up to `panel_area`; `sheets ≥ sheets_lower_bound = ceil(panel area /
+/// usable sheet area)`, `utilization = panel_area / (sheets × sheet area)`.
+pub fn check_output(
+    model: &Path,
+    out: &Path,
+    m: &Value,
+    what: &str,
+    dxf: DxfCheck,
+    panel_id: impl Fn(&Value) -> String,
+) -> Sheets {
+    let name = model.file_stem().unwrap().to_string_lossy().into_owned();
+    let panels = count(m, "counts.panels");
+    let sheets = count(m, "counts.sheets");
+    assert!(sheets >= 1, "{what}: no sheets");
+
+    // The files: one SVG and one DXF per sheet, the manifest and the assembled model.
+    let digits = sheets.to_string().len().max(2);
+    let mut expected =
+        BTreeSet::from(["manifest.json".to_string(), format!("{name}-assembled.obj")]);
+    for k in 1..=sheets {
+        expected.insert(format!("{name}-{k:0digits$}.svg"));
+        expected.insert(format!("{name}-{k:0digits$}.dxf"));
+    }
+    assert_eq!(entry_names(out), expected, "{what}: output files");
+
+    let checked = check_sheets(out, m, dxf);
+    let total = checked.total();
+
+    // Sheets against the manifest.
+    assert_eq!(
+        checked.svg_files.len(),
+        sheets,
+        "{what}: SVG files = counts.sheets"
+    );
+    assert_eq!(total.panels, panels, "{what}: panels on the sheets");
+    assert_eq!(
+        total.holes,
+        count(m, "counts.holes"),
+        "{what}: holes on the sheets"
+    );
+    let panel_area = num(m, "panel_area");
+    assert!(
+        close(total.panel_area, panel_area, 1e-4),
+        "{what}: outlines on the sheets enclose {} mm², manifest panel_area {panel_area}",
+        total.panel_area
+    );
+    for (kind, drawn) in [
+        ("cut", total.cut_length),
+        ("score", total.score_length),
+        ("engrave", total.engrave_length),
+    ] {
+        let said = num(m, &format!("lengths.{kind}"));
+        assert!(
+            close(drawn, said, 1e-4),
+            "{what}: {kind} length drawn {drawn} mm, manifest says {said} mm"
+        );
+    }
+    let entries = m["sheets"].as_array().expect("manifest sheets list");
+    assert_eq!(entries.len(), sheets, "{what}: manifest sheets list");
+    for (k, (entry, (file, stats))) in entries
+        .iter()
+        .zip(checked.svg_files.iter().zip(&checked.stats))
+        .enumerate()
+    {
+        assert_eq!(count(entry, "sheet"), k + 1, "{what}: sheet numbers");
+        assert_eq!(
+            entry["file"].as_str(),
+            Some(file.as_str()),
+            "{what}: sheet file"
+        );
+        assert_eq!(
+            count(entry, "panels"),
+            stats.panels,
+            "{what}: panels on {file}"
+        );
+    }
+
+    // The per-panel list: one entry per panel, ids from their source, on the sheet that
+    // holds it.
+    let list = m["panels"].as_array().expect("manifest panels list");
+    assert_eq!(list.len(), panels, "{what}: manifest panels list");
+    let mut ids = BTreeSet::new();
+    let mut per_sheet = vec![0usize; sheets];
+    let mut area_sum = 0.0;
+    for p in list {
+        let id = p["id"].as_str().unwrap();
+        assert_eq!(id, panel_id(p), "{what}: panel id names its source");
+        assert!(ids.insert(id.to_string()), "{what}: panel id {id} twice");
+        let sheet = count(p, "sheet");
+        assert!(
+            (1..=sheets).contains(&sheet),
+            "{what}: {id} on sheet {sheet}"
+        );
+        per_sheet[sheet - 1] += 1;
+        area_sum += num(p, "area");
+    }
+    let on_sheets: Vec<usize> = checked.stats.iter().map(|s| s.panels).collect();
+    assert_eq!(per_sheet, on_sheets, "{what}: panels per sheet");
+    assert!(
+        close(area_sum, panel_area, 1e-6) || (area_sum - panel_area).abs() < 1e-4 * panels as f64,
+        "{what}: Σ panel areas {area_sum} vs panel_area {panel_area}"
+    );
+
+    // Layout figures.
+    let lower = count(m, "counts.sheets_lower_bound");
+    assert!(
+        sheets >= lower,
+        "{what}: {sheets} sheets below the lower bound {lower}"
+    );
+    let spec = sheet_spec(m);
+    let usable = (spec.width - 2.0 * spec.margin) * (spec.height - 2.0 * spec.margin);
+    let ratio = panel_area / usable;
+    if (ratio - ratio.round()).abs() > 1e-6 {
+        assert_eq!(lower, ratio.ceil() as usize, "{what}: sheets_lower_bound");
+    }
+    let utilization = num(m, "utilization");
+    let wanted = panel_area / (sheets as f64 * spec.width * spec.height);
+    assert!(
+        (utilization - wanted).abs() <= 1e-4,
+        "{what}: utilization {utilization}, panel_area / sheet area = {wanted}"
+    );
+    eprintln!(
+        "{what}: {panels} panels on {sheets} sheets (lower bound {lower}, utilization {:.1}%), {} holes",
+        100.0 * utilization,
+        total.holes
+    );
+    checked
+}
+
+// =======================================================================================
+// The library's pipeline up to the flat panels
+// =======================================================================================
+
+/// What [`pipeline`] produced.
+pub struct Pipeline {
+    /// The mesh the scheme used (scaled to mm, faces split).
+    pub mesh: Mesh,
+    /// The faces split before the scheme.
+    pub split: SplitReport,
+    /// The scheme's output (3D panels, connections, notes).
+    pub output: SchemeOutput,
+    /// The panels unrolled, in the same order.
+    pub flat: Vec<FlatPanel>,
+}
+
+/// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
+/// scheme, flatten.
+pub fn pipeline(job: &Job) -> Pipeline {
+    let (_raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
+    let mut mesh = prepared.mesh;
+    let geometry = mesh.geometry_facts(job.model.planarity_tol);
+    let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
+    mesh.scale(mm_per_unit);
+    let split = faces_to_split(
+        &mesh,
+        job.model.planarity_tol,
+        needs_convex_faces(job.scheme),
+    );
+    if split.count() > 0 {
+        mesh = split_faces(&mesh, &split).expect("split faces");
+    }
+    let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
+    let flat = output
+        .panels
+        .iter()
+        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id)))
+        .collect();
+    Pipeline {
+        mesh,
+        split,
+        output,
+        flat,
+    }
+}
+
+/// [`pipeline`] as a tuple: the mesh the scheme used, the number of connections, the 3D
+/// and the flat panels.
+pub fn panels_of(job: &Job) -> (Mesh, usize, Vec<Panel>, Vec<FlatPanel>) {
+    let p = pipeline(job);
+    (p.mesh, p.output.connections, p.output.panels, p.flat)
+}
+
+/// Build options for `scheme` at `--size size --holes holes --out out` (the rest at
+/// their defaults), to adjust before [`resolve`].
+pub fn options(scheme: SchemeName, size: &str, holes: u32, out: &Path) -> BuildOptions {
+    BuildOptions {
+        scheme: Some(scheme),
+        holes: Some(holes),
+        out: Some(out.to_path_buf()),
+        model: ModelOptions {
+            size: Some(size.to_string()),
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+}
+
+/// Resolves build options for a model, as the command line does.
+pub fn resolve(options: BuildOptions, model: &Path) -> Job {
+    options.resolve(model).expect("options resolve")
+}
+
+/// The job of `unfold MODEL --scheme SCHEME --size SIZE --holes HOLES --out OUT`.
+pub fn job(scheme: SchemeName, model: &Path, size: &str, holes: u32, out: &Path) -> Job {
+    resolve(options(scheme, size, holes, out), model)
+}
+
+// =======================================================================================
+// Golden files
+// =======================================================================================
+
+/// The first line where two texts differ, for the failure message.
+pub fn first_difference(want: &[u8], got: &[u8]) -> String {
+    let (want, got) = (String::from_utf8_lossy(want), String::from_utf8_lossy(got));
+    for (k, (a, b)) in want.lines().zip(got.lines()).enumerate() {
+        if a != b {
+            return format!("line {}:\n  golden: {a}\n  now:    {b}", k + 1);
+        }
+    }
+    format!(
+        "one is a prefix of the other ({} and {} lines)",
+        want.lines().count(),
+        got.lines().count()
+    )
+}
+
+/// What [`compare_with_golden`] did.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Golden {
+    /// The output equals the golden files.
+    Matched,
+    /// `UNFOLD_UPDATE_GOLDEN=1`: the golden folder was rewritten from the output.
+    Rewritten,
+}
+
+/// Compares the output folder `out` with the golden folder byte for byte (after
+/// checking that no file names the temporary folder `tmp`), or, with
+/// `UNFOLD_UPDATE_GOLDEN=1`, rewrites the golden folder from it. `test` names the test
+/// target for the update hint (`cargo test --test TEST golden`).
+pub fn compare_with_golden(out: &Path, golden: &Path, tmp: &Path, test: &str) -> Golden {
+    let now = folder_files(out);
+    for (name, bytes) in &now {
+        let text = String::from_utf8_lossy(bytes);
+        assert!(
+            !text.contains(&*tmp.to_string_lossy()),
+            "{name} names the temporary folder"
+        );
+    }
+
+    if std::env::var("UNFOLD_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+        if golden.exists() {
+            std::fs::remove_dir_all(golden).unwrap();
+        }
+        std::fs::create_dir_all(golden).unwrap();
+        for (name, bytes) in &now {
+            std::fs::write(golden.join(name), bytes).unwrap();
+        }
+        eprintln!("UNFOLD_UPDATE_GOLDEN=1: rewrote {}", golden.display());
+        return Golden::Rewritten;
+    }
+    assert!(
+        golden.is_dir(),
+        "{} is missing; create it with UNFOLD_UPDATE_GOLDEN=1 cargo test --test {test} golden",
+        golden.display()
+    );
+    let want = folder_files(golden);
+    assert_eq!(
+        now.keys().collect::<Vec<_>>(),
+        want.keys().collect::<Vec<_>>(),
+        "the output files differ from the golden ones"
+    );
+    for (name, bytes) in &want {
+        assert!(
+            &now[name] == bytes,
+            "{name} differs from {}; if the change is intended, rerun with UNFOLD_UPDATE_GOLDEN=1\nfirst difference at {}",
+            golden.join(name).display(),
+            first_difference(bytes, &now[name])
+        );
+    }
+    Golden::Matched
+}
