@@ -73,14 +73,21 @@ impl FaceFrame {
     }
 }
 
-/// The face band of `f` in 3D and in its frame.
+/// The face band of `f` in 3D and in its frame. The band corners are projected onto
+/// the face's plane (through its centre, normal to its vector area), so every flap is
+/// an exactly planar facet and the holes of a corner lie on both flaps even when the
+/// face is planar only within the tolerance; on a planar face nothing moves.
 pub fn band(
     mesh: &Mesh,
     f: FaceId,
     options: &SchemeOptions,
 ) -> (Vec<DVec3>, Vec<DVec2>, FaceFrame) {
-    let band = face_band(mesh, f, options.face_scale);
     let frame = FaceFrame::new(mesh, f);
+    let normal = frame.ex.cross(frame.ey);
+    let band: Vec<DVec3> = face_band(mesh, f, options.face_scale)
+        .into_iter()
+        .map(|p| p - (p - frame.centre).dot(normal) * normal)
+        .collect();
     let flat = band.iter().map(|&p| frame.to2(p)).collect();
     (band, flat, frame)
 }
