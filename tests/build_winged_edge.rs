@@ -1,0 +1,155 @@
+//! End-to-end tests of the winged-edge scheme (SPEC.md §2): the same panel and
+//! connection counts as quad-edge, every sheet through the independent checker and every
+//! DXF through ezdxf, the holes of every connection meeting in 3D through the flat
+//! panels' maps (twice as many with half-length wings, which give two shared regions per
+//! corner), and golden files of the cube.
+//!
+//! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_winged_edge golden` rewrites
+//! `tests/golden/hexahedron-winged-edge/`.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use glam::DVec3;
+use tempfile::TempDir;
+
+use common::build::{
+    build, check_output, check_sheets, compare_with_golden, count, crate_dir, finish, model,
+    options, pipeline, read_manifest, resolve, unfold_command, DxfCheck, Golden,
+};
+use unfold::config::SchemeName;
+
+/// The winged-edge job for a project model.
+fn winged_job(name: &str, size: &str, holes: u32, shift: i32, out: &Path) -> unfold::Job {
+    let mut o = options(SchemeName::WingedEdge, size, holes, out);
+    o.shift = Some(shift);
+    resolve(o, &model(name))
+}
+
+#[test]
+fn a_panel_per_edge_and_every_sheet_checks_for_every_shift() {
+    let tmp = TempDir::new().unwrap();
+    for name in ["tetrahedron", "hexahedron", "icosahedron", "torus-8x6", "genus2"] {
+        for shift in ["0", "1", "-1"] {
+            let what = format!("{name} shift {shift}");
+            let out = tmp.path().join(format!("{name}{shift}"));
+            let m = build(
+                "winged-edge",
+                &model(name),
+                "300mm",
+                &out,
+                &["--shift", shift, "--format", "svg,dxf"],
+            );
+            let edges = count(&m, "input.edges");
+            assert_eq!(count(&m, "counts.panels"), edges, "{what}: panels = E");
+            assert_eq!(count(&m, "counts.connections"), 2 * edges, "{what}: 2E");
+            check_output(&model(name), &out, &m, &what, DxfCheck::All, |p| {
+                format!("E{}", p["source"]["edge"])
+            });
+            let max = m["max_developability_error"].as_f64().unwrap();
+            assert!(max < 1e-9 * 300.0, "{what}: developability {max}");
+        }
+    }
+}
+
+/// Every flat hole mapped back to 3D through its facet's frame; grouped by connection
+/// (a face corner): two panels (the edges meeting there), the same holes on both, at
+/// the same 3D points. Returns holes per connection.
+fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
+    let p = pipeline(job);
+    let size = 300.0;
+    let mut by_connection: BTreeMap<u32, BTreeMap<String, Vec<DVec3>>> = BTreeMap::new();
+    for flat in &p.flat {
+        for hole in &flat.holes {
+            let back = flat.frames[hole.facet as usize].to_3d(hole.center);
+            by_connection
+                .entry(hole.connection)
+                .or_default()
+                .entry(flat.id.clone())
+                .or_default()
+                .push(back);
+        }
+    }
+    let mesh = &p.mesh;
+    let mut counts = BTreeMap::new();
+    for (connection, panels) in &by_connection {
+        let h = unfold::mesh::HalfEdgeId(*connection);
+        let expected: Vec<String> = {
+            let mut ids = vec![
+                format!("E{}", h.edge().0),
+                format!("E{}", mesh.prev(h).edge().0),
+            ];
+            ids.sort();
+            ids
+        };
+        let got: Vec<String> = panels.keys().cloned().collect();
+        assert_eq!(got, expected, "{what}: connection {connection} panels");
+        let sides: Vec<&Vec<DVec3>> = panels.values().collect();
+        assert_eq!(sides[0].len(), sides[1].len(), "{what}: connection {connection}");
+        for a in sides[0] {
+            let nearest = sides[1]
+                .iter()
+                .map(|b| a.distance(*b))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                nearest < 1e-9 * size,
+                "{what}: connection {connection}: a hole has no partner ({nearest} mm)"
+            );
+        }
+        counts.insert(*connection, sides[0].len());
+    }
+    counts
+}
+
+#[test]
+fn holes_of_a_connection_meet_in_3d() {
+    let tmp = TempDir::new().unwrap();
+    for (name, shift, per_region) in [
+        ("hexahedron", 0, 2),
+        ("hexahedron", 1, 2),
+        ("hexahedron", -1, 2),
+        ("icosahedron", 0, 1),
+        ("dodecahedron", 1, 2),
+    ] {
+        let what = format!("{name} shift {shift}");
+        let job = winged_job(name, "300mm", per_region, shift, tmp.path());
+        let counts = holes_per_connection(&job, &what);
+        // Half-length wings make two shared regions per corner, full wings one.
+        let regions = if shift == 0 { 2 } else { 1 };
+        let p = pipeline(&job);
+        let corners: usize = p.mesh.faces().map(|f| p.mesh.face_degree(f)).sum();
+        assert_eq!(counts.len(), corners, "{what}: every corner has holes");
+        assert!(
+            counts.values().all(|&n| n == regions * per_region as usize),
+            "{what}: holes per connection {:?}",
+            counts.values().collect::<std::collections::BTreeSet<_>>()
+        );
+    }
+}
+
+#[test]
+fn golden_files_of_the_cube() {
+    let golden = crate_dir().join("tests/golden/hexahedron-winged-edge");
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("hexahedron");
+    let run = finish(
+        unfold_command()
+            .current_dir(crate_dir())
+            .arg("models/hexahedron.obj")
+            .args(["--size", "150mm", "--scheme", "winged-edge", "--holes", "2"])
+            .args(["--format", "svg,dxf", "--out"])
+            .arg(&out),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let manifest = read_manifest(&out);
+    assert_eq!(manifest["input"]["path"], "models/hexahedron.obj");
+    if compare_with_golden(&out, &golden, tmp.path(), "build_winged_edge") == Golden::Rewritten {
+        return;
+    }
+    let sheets = check_sheets(&out, &manifest, DxfCheck::All);
+    let total = sheets.total();
+    assert_eq!(total.panels, 12);
+    assert_eq!(total.holes, count(&manifest, "counts.holes"));
+}
