@@ -215,6 +215,16 @@ pub struct ModelOptions {
     /// divided by the face's diameter) exceeds this are non-planar. [default: 0.001]
     #[arg(long, value_name = "FRACTION")]
     pub planarity_tol: Option<f64>,
+
+    /// Simplify a triangle mesh to about this many edges (within 2 %), keeping its
+    /// holes and genus. [default: no simplification]
+    #[arg(long, value_name = "N", conflicts_with = "target_faces")]
+    pub target_edges: Option<usize>,
+
+    /// Simplify a triangle mesh to about this many faces, keeping its holes and genus.
+    /// [default: no simplification]
+    #[arg(long, value_name = "N")]
+    pub target_faces: Option<usize>,
 }
 
 /// How model units become millimetres.
@@ -249,6 +259,8 @@ pub struct ModelSettings {
     pub weld: bool,
     /// Planarity tolerance (fraction of face diameter).
     pub planarity_tol: f64,
+    /// Simplification budget, if any.
+    pub budget: Option<crate::mesh::simplify::Budget>,
 }
 
 impl ModelOptions {
@@ -260,6 +272,8 @@ impl ModelOptions {
             scale: self.scale.or(other.scale),
             weld: self.weld || other.weld,
             planarity_tol: self.planarity_tol.or(other.planarity_tol),
+            target_edges: self.target_edges.or(other.target_edges),
+            target_faces: self.target_faces.or(other.target_faces),
         }
     }
 
@@ -287,7 +301,23 @@ impl ModelOptions {
                 "--planarity-tol: {planarity_tol} must be between 0 and 1 (a fraction of the face size)"
             )));
         }
+        let budget = match (self.target_edges, self.target_faces) {
+            (Some(_), Some(_)) => {
+                return Err(Error::Usage(
+                    "give --target-edges or --target-faces, not both".to_string(),
+                ))
+            }
+            (Some(0), _) | (_, Some(0)) => {
+                return Err(Error::Usage(
+                    "--target-edges and --target-faces must be positive".to_string(),
+                ))
+            }
+            (Some(e), None) => Some(crate::mesh::simplify::Budget::Edges(e)),
+            (None, Some(f)) => Some(crate::mesh::simplify::Budget::Faces(f)),
+            (None, None) => None,
+        };
         Ok(ModelSettings {
+            budget,
             scaling: Scaling {
                 size,
                 unit_mm: self.units.unwrap_or(LengthUnit::Mm).mm(),

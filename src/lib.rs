@@ -33,18 +33,39 @@ pub use run::{report_text, run, Outcome};
 use mesh::read::Group;
 use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};
 
-/// Reads and prepares a model: the first two stages of every job.
+/// Reads and prepares a model: the first two stages of every job. Simplification (with
+/// `--target-edges` / `--target-faces`) is part of preparation.
 pub fn load_model(
     path: &Path,
     settings: &ModelSettings,
 ) -> Result<(mesh::RawModel, PreparedModel)> {
     let raw = mesh::read_model(path)?;
-    let prepared = mesh::prepare(
+    let mut prepared = mesh::prepare(
         &raw,
         &PrepareOptions {
             weld: settings.weld,
         },
     )?;
+    if let Some(budget) = settings.budget {
+        let (simplified, report) = mesh::simplify::simplify(&prepared.mesh, budget)
+            .map_err(|e| InputError::new(path, error::Location::File, e.to_string(), ""))?;
+        let message = if report.before == report.after {
+            format!(
+                "{} faces and {} edges are already within the budget; not simplified",
+                report.before.0, report.before.1
+            )
+        } else {
+            format!(
+                "simplified from {} faces and {} edges to {} faces and {} edges; largest deviation from the original surface about {:.3e} model units (meshoptimizer's estimate)",
+                report.before.0, report.before.1, report.after.0, report.after.1, report.deviation
+            )
+        };
+        prepared.notes.push(Note {
+            kind: "simplified",
+            message,
+        });
+        prepared.mesh = simplified;
+    }
     Ok((raw, prepared))
 }
 

@@ -270,7 +270,7 @@ fn build_manifest(
             source: match p.source {
                 Source::Face(f) => manifest::PanelSource::Face {
                     face: f,
-                    input_face: mesh.face_source(FaceId(f)),
+                    input_face: Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX),
                 },
                 Source::Edge(e) => manifest::PanelSource::Edge { edge: e },
                 Source::Cycle { cycle, segment } => manifest::PanelSource::Cycle { cycle, segment },

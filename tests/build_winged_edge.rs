@@ -31,7 +31,13 @@ fn winged_job(name: &str, size: &str, holes: u32, shift: i32, out: &Path) -> unf
 #[test]
 fn a_panel_per_edge_and_every_sheet_checks_for_every_shift() {
     let tmp = TempDir::new().unwrap();
-    for name in ["tetrahedron", "hexahedron", "icosahedron", "torus-8x6", "genus2"] {
+    for name in [
+        "tetrahedron",
+        "hexahedron",
+        "icosahedron",
+        "torus-8x6",
+        "genus2",
+    ] {
         for shift in ["0", "1", "-1"] {
             let what = format!("{name} shift {shift}");
             let out = tmp.path().join(format!("{name}{shift}"));
@@ -87,7 +93,11 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
         let got: Vec<String> = panels.keys().cloned().collect();
         assert_eq!(got, expected, "{what}: connection {connection} panels");
         let sides: Vec<&Vec<DVec3>> = panels.values().collect();
-        assert_eq!(sides[0].len(), sides[1].len(), "{what}: connection {connection}");
+        assert_eq!(
+            sides[0].len(),
+            sides[1].len(),
+            "{what}: connection {connection}"
+        );
         for a in sides[0] {
             let nearest = sides[1]
                 .iter()

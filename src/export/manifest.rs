@@ -173,8 +173,8 @@ pub enum PanelSource {
     Face {
         /// Face index in the prepared mesh.
         face: u32,
-        /// Face index in the input file.
-        input_face: u32,
+        /// Face index in the input file (none after simplification).
+        input_face: Option<u32>,
     },
     /// An edge.
     Edge {

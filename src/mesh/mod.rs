@@ -12,6 +12,7 @@ pub mod ids;
 pub mod polygons;
 pub mod prepare;
 pub mod read;
+pub mod simplify;
 pub mod soup;
 pub mod split;
 pub mod topology;

@@ -1,0 +1,215 @@
+//! Simplification to a panel budget through meshoptimizer's edge-collapse simplifier
+//! (faces with more than three corners are triangulated first). Border vertices only collapse along their border, so holes
+//! stay holes; the result is rebuilt by the ordinary half-edge builder and refused if it
+//! is not a manifold of the same genus with the same number of boundary loops.
+
+use super::build::build_mesh;
+use super::halfedge::Mesh;
+use super::polygons::Polygons;
+
+/// What to aim for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Budget {
+    /// About this many faces.
+    Faces(usize),
+    /// About this many edges (within 2 % when the simplifier can reach it).
+    Edges(usize),
+}
+
+/// What simplification did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimplifyReport {
+    /// Faces and edges before.
+    pub before: (usize, usize),
+    /// Faces and edges after.
+    pub after: (usize, usize),
+    /// The simplifier's estimate of the largest deviation from the original surface, in
+    /// model units.
+    pub deviation: f64,
+}
+
+/// Why a mesh cannot be simplified as asked.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum SimplifyError {
+    /// The simplified mesh changed topology.
+    #[error("simplifying to {faces} faces would change the topology (genus {genus_before} -> {genus_after}, boundary loops {loops_before} -> {loops_after}); ask for a larger budget")]
+    Topology {
+        faces: usize,
+        genus_before: i64,
+        genus_after: i64,
+        loops_before: usize,
+        loops_after: usize,
+    },
+    /// The simplified triangles do not build into a valid mesh.
+    #[error("the simplified mesh is not a valid manifold ({0}); ask for a larger budget")]
+    Invalid(String),
+}
+
+/// Simplifies a triangle mesh toward `budget`. Deterministic: meshoptimizer is
+/// single-threaded and deterministic for the same input.
+pub fn simplify(mesh: &Mesh, budget: Budget) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+    let before = mesh.topology();
+    let positions: Vec<f32> = mesh
+        .positions()
+        .iter()
+        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .collect();
+    let bytes: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
+    let adapter = meshopt::VertexDataAdapter::new(&bytes, 12, 0)
+        .map_err(|e| SimplifyError::Invalid(e.to_string()))?;
+    // The simplifier works on triangles: larger faces are split first (the same
+    // triangulation the schemes use for non-planar faces).
+    let mut indices: Vec<u32> = Vec::with_capacity(3 * mesh.face_count());
+    for f in mesh.faces() {
+        let corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+        if corners.len() == 3 {
+            indices.extend_from_slice(&corners);
+        } else {
+            let points: Vec<glam::DVec3> = mesh.face_positions(f).collect();
+            for t in super::split::triangulate(&points) {
+                indices.extend(t.map(|k| corners[k]));
+            }
+        }
+    }
+    let extent = {
+        let (lo, hi) = super::geometry::bounding_box(mesh.positions().iter().copied());
+        (hi - lo).length()
+    };
+
+    // Three evenly spaced vertices of every boundary loop stay put, so no hole can
+    // shrink to nothing; the rest of a border still simplifies along itself.
+    let mut locked = vec![false; mesh.vertex_count()];
+    for start in mesh.boundary_loops() {
+        let ring: Vec<u32> = mesh.loop_from(start).map(|h| mesh.origin(h).0).collect();
+        for k in 0..3 {
+            locked[ring[k * ring.len() / 3] as usize] = true;
+        }
+    }
+    // meshoptimizer asserts (aborting the process) if asked for more triangles than it
+    // has: never ask.
+    let run = |target_faces: usize| {
+        let target_faces = target_faces.clamp(1, indices.len() / 3);
+        let mut error = 0.0f32;
+        let out = meshopt::simplify_with_locks(
+            &indices,
+            &adapter,
+            &locked,
+            3 * target_faces.max(1),
+            1.0,
+            meshopt::SimplifyOptions::empty(),
+            Some(&mut error),
+        );
+        (out, error)
+    };
+    // Edges of a triangle mesh: 3F = 2E − b, so aim F at (2E − b) / 3 and correct a few
+    // times with what the simplifier really produced.
+    let boundary = before.boundary_edges;
+    // Faces and edges as the simplifier sees them (after triangulation).
+    let triangles = indices.len() / 3;
+    let mut target = match budget {
+        Budget::Faces(f) => f,
+        Budget::Edges(e) => (2 * e).saturating_sub(boundary) / 3,
+    };
+    if target >= triangles {
+        // Already within the budget: nothing to collapse.
+        return Ok((
+            mesh.clone(),
+            SimplifyReport {
+                before: (before.faces, before.edges),
+                after: (before.faces, before.edges),
+                deviation: 0.0,
+            },
+        ));
+    }
+    let (mut out, mut error) = run(target);
+    if let Budget::Edges(wanted) = budget {
+        for _ in 0..6 {
+            let got = edge_count(&out);
+            if got.abs_diff(wanted) * 100 <= 2 * wanted || got == 0 {
+                break;
+            }
+            let scaled = (target as f64 * wanted as f64 / got as f64).round() as usize;
+            if scaled == target {
+                break;
+            }
+            target = scaled;
+            (out, error) = run(target);
+        }
+    }
+
+    // A collapse can fold two triangles onto each other (the same three vertices, once
+    // each way round): that pocket encloses nothing and gives its edges four faces.
+    // Remove both copies, and any triangle that lost a corner.
+    let out = drop_folded_pairs(&out);
+    // Compact the vertices the simplified triangles still use.
+    let mut new_index = vec![u32::MAX; mesh.vertex_count()];
+    let mut polys = Polygons::new();
+    let mut source = Vec::new();
+    for &v in &out {
+        if new_index[v as usize] == u32::MAX {
+            new_index[v as usize] = polys.positions.len() as u32;
+            polys.positions.push(mesh.positions()[v as usize]);
+            source.push(mesh.vertex_source(super::ids::VertexId(v)));
+        }
+    }
+    for tri in out.chunks_exact(3) {
+        polys.push_face(
+            &tri.iter()
+                .map(|&v| new_index[v as usize])
+                .collect::<Vec<_>>(),
+        );
+    }
+    let face_source: Vec<u32> = vec![u32::MAX; polys.face_count()];
+    let (simplified, _) = build_mesh(&polys, Some(&source), Some(&face_source))
+        .map_err(|e| SimplifyError::Invalid(e.to_string()))?;
+    let after = simplified.topology();
+    if after.genus != before.genus || after.boundary_loops != before.boundary_loops {
+        return Err(SimplifyError::Topology {
+            faces: after.faces,
+            genus_before: before.genus,
+            genus_after: after.genus,
+            loops_before: before.boundary_loops,
+            loops_after: after.boundary_loops,
+        });
+    }
+    Ok((
+        simplified,
+        SimplifyReport {
+            before: (triangles, edge_count(&indices)),
+            after: (after.faces, after.edges),
+            deviation: error as f64 * extent,
+        },
+    ))
+}
+
+/// Triangles of `indices` without degenerate ones and without pairs that use the same
+/// three vertices (both copies go).
+fn drop_folded_pairs(indices: &[u32]) -> Vec<u32> {
+    let key = |t: &[u32]| {
+        let mut k = [t[0], t[1], t[2]];
+        k.sort_unstable();
+        k
+    };
+    let mut seen: std::collections::HashMap<[u32; 3], usize> = std::collections::HashMap::new();
+    for t in indices.chunks_exact(3) {
+        *seen.entry(key(t)).or_insert(0) += 1;
+    }
+    indices
+        .chunks_exact(3)
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2] && seen[&key(t)] == 1)
+        .flatten()
+        .copied()
+        .collect()
+}
+
+/// Undirected edges of a triangle index list.
+fn edge_count(indices: &[u32]) -> usize {
+    let mut edges: Vec<(u32, u32)> = indices
+        .chunks_exact(3)
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges.len()
+}

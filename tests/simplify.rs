@@ -1,0 +1,116 @@
+//! Simplification to a panel budget (`--target-edges`, `--target-faces`): the result is
+//! a valid manifold with the same genus and boundary loops, near the budget, the same
+//! every run; and the thesis' headline job runs end to end.
+
+mod common;
+
+use tempfile::TempDir;
+
+use common::build::{build_run, check_output, count, inspect_json, model, shared_models, DxfCheck};
+
+/// `inspect --json` facts after simplification: (edges, faces, genus, boundary loops).
+fn simplified(path: &std::path::Path, budget: &[&str]) -> (usize, usize, usize, usize) {
+    let report = inspect_json(path, budget);
+    let kinds: Vec<&str> = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n["kind"].as_str().unwrap())
+        .collect();
+    assert!(kinds.contains(&"simplified"), "{kinds:?}");
+    (
+        count(&report, "mesh.edges"),
+        count(&report, "mesh.faces"),
+        count(&report, "mesh.genus"),
+        count(&report, "mesh.boundary_loops"),
+    )
+}
+
+#[test]
+fn topology_is_kept_on_the_project_models() {
+    for (name, genus) in [("genus2", 2), ("genus3", 3)] {
+        // Their 50/68 quads become 100/136 triangles first; 150 edges is a real cut.
+        let (edges, _, g, loops) = simplified(&model(name), &["--target-edges", "150"]);
+        assert_eq!((g, loops), (genus, 0), "{name}");
+        assert!(edges <= 153, "{name}: {edges} edges");
+    }
+    // A budget above the model's size leaves it alone.
+    let report = inspect_json(&model("genus2"), &["--target-faces", "100000"]);
+    assert_eq!(count(&report, "mesh.faces"), 50);
+}
+
+#[test]
+fn topology_is_kept_on_the_shared_models() {
+    let Some(shared) = shared_models("topology_is_kept_on_the_shared_models") else {
+        return;
+    };
+    for (name, budget, genus, loops) in [
+        ("spot.obj", "600", 0, 0),
+        ("spot.obj", "150", 0, 0),
+        ("stanford-bunny.obj", "625", 0, 5),
+        ("stanford-bunny.obj", "1500", 0, 5),
+        ("fertility.obj", "600", 4, 0),
+    ] {
+        let what = format!("{name} to {budget} edges");
+        let (edges, faces, g, l) = simplified(&shared.join(name), &["--target-edges", budget]);
+        assert_eq!((g, l), (genus, loops), "{what}: genus, boundary loops");
+        let wanted: usize = budget.parse().unwrap();
+        assert!(
+            edges.abs_diff(wanted) * 100 <= 2 * wanted,
+            "{what}: {edges} edges is not within 2 %"
+        );
+        assert!(faces > 0, "{what}");
+    }
+    // By faces too.
+    let (_, faces, g, _) = simplified(&shared.join("spot.obj"), &["--target-faces", "500"]);
+    assert_eq!(g, 0);
+    assert!((450..=500).contains(&faces), "spot to 500 faces: {faces}");
+}
+
+#[test]
+fn too_small_a_budget_is_refused_clearly() {
+    let path = model("genus3");
+    let run =
+        common::build::unfold(["inspect", path.to_str().unwrap(), "--target-edges", "60"].iter());
+    assert_eq!(run.code, Some(3), "{}", run.stderr);
+    assert!(run.stderr.contains("larger budget"), "{}", run.stderr);
+    assert_eq!(run.stderr.lines().count(), 1, "{}", run.stderr);
+}
+
+#[test]
+fn the_thesis_bunny_builds_end_to_end() {
+    let Some(shared) = shared_models("the_thesis_bunny_builds_end_to_end") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let bunny = shared.join("stanford-bunny.obj");
+    let mut manifests = Vec::new();
+    for run in ["a", "b"] {
+        let out = tmp.path().join(run);
+        let (m, report) = build_run(
+            "quad-edge",
+            &bunny,
+            "4ft",
+            &out,
+            &["--target-edges", "625", "--format", "svg,dxf"],
+        );
+        let edges = count(&m, "input.edges");
+        assert!((613..=637).contains(&edges), "{edges} edges, not 625 ± 2 %");
+        assert_eq!(count(&m, "counts.panels"), edges);
+        assert_eq!(count(&m, "input.boundary_loops"), 5);
+        assert_eq!(count(&m, "input.genus"), 0);
+        assert!(
+            report.stderr.contains("simplified from 69451 faces"),
+            "{}",
+            report.stderr
+        );
+        check_output(&bunny, &out, &m, "bunny", DxfCheck::FirstAndLast, |p| {
+            format!("E{}", p["source"]["edge"])
+        });
+        manifests.push(std::fs::read(out.join("manifest.json")).unwrap());
+    }
+    assert_eq!(
+        manifests[0], manifests[1],
+        "simplification is deterministic"
+    );
+}
