@@ -23,9 +23,9 @@ use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
-    check_output, check_sheets, close, compare_with_golden, count, crate_dir, distance_to_border,
-    entry_names, finish, folder_files, inside, inspect_json, model, num, obj_face_count, panels_of,
-    read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck, Golden,
+    check_output, check_sheets, close, count, distance_to_border, entry_names, finish,
+    folder_files, golden_build, inside, inspect_json, model, num, obj_face_count, panels_of,
+    read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck,
 };
 use unfold::config::{Job, SchemeName};
 use unfold::mesh::EdgeId;
@@ -561,25 +561,15 @@ fn output_is_byte_identical_across_runs_and_threads() {
 
 #[test]
 fn golden_files_of_a_small_model() {
-    let golden = crate_dir().join("tests/golden/tetrahedron-half-edge");
-    let tmp = TempDir::new().unwrap();
-    let out = tmp.path().join("tetrahedron");
-    // A model path relative to the crate root: the manifest's input.path is the same
-    // on every machine.
-    let run = finish(
-        unfold_command()
-            .current_dir(crate_dir())
-            .arg("models/tetrahedron.obj")
-            .args(["--size", "150mm", "--scheme", "half-edge", "--holes", "1"])
-            .args(["--format", "svg,dxf", "--out"])
-            .arg(&out),
-    );
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let manifest = read_manifest(&out);
-    assert_eq!(manifest["input"]["path"], "models/tetrahedron.obj");
-    if compare_with_golden(&out, &golden, tmp.path(), "build_half_edge") == Golden::Rewritten {
+    let args = ["--size", "150mm", "--scheme", "half-edge", "--holes", "1"];
+    let Some((_tmp, out, manifest)) = golden_build(
+        "build_half_edge",
+        "tetrahedron-half-edge",
+        "tetrahedron",
+        &args,
+    ) else {
         return;
-    }
+    };
     // The golden sheets themselves pass the independent check.
     let sheets = check_sheets(&out, &manifest, DxfCheck::All);
     assert_eq!(sheets.total().panels, 4);

@@ -26,9 +26,8 @@ use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
-    check_output, check_sheets, compare_with_golden, count, crate_dir, distance_to_border, finish,
-    inside, inspect_json, model, num, pipeline, read_manifest, read_simple_obj, resolve,
-    shared_models, unfold_command, DxfCheck, Golden, Pipeline, Run,
+    check_output, check_sheets, count, distance_to_border, golden_build, inside, inspect_json,
+    model, num, pipeline, read_simple_obj, resolve, shared_models, DxfCheck, Pipeline, Run,
 };
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job, SchemeName};
@@ -1240,25 +1239,15 @@ fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
 
 #[test]
 fn golden_files_of_a_small_model() {
-    let golden = crate_dir().join("tests/golden/hexahedron-quad-edge");
-    let tmp = TempDir::new().unwrap();
-    let out = tmp.path().join("hexahedron");
-    // A model path relative to the crate root: the manifest's input.path is the same
-    // on every machine.
-    let run = finish(
-        unfold_command()
-            .current_dir(crate_dir())
-            .arg("models/hexahedron.obj")
-            .args(["--size", "150mm", "--scheme", "quad-edge", "--holes", "2"])
-            .args(["--format", "svg,dxf", "--out"])
-            .arg(&out),
-    );
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let manifest = read_manifest(&out);
-    assert_eq!(manifest["input"]["path"], "models/hexahedron.obj");
-    if compare_with_golden(&out, &golden, tmp.path(), "build_quad_edge") == Golden::Rewritten {
+    let args = ["--size", "150mm", "--scheme", "quad-edge", "--holes", "2"];
+    let Some((_tmp, out, manifest)) = golden_build(
+        "build_quad_edge",
+        "hexahedron-quad-edge",
+        "hexahedron",
+        &args,
+    ) else {
         return;
-    }
+    };
     // The golden sheets themselves pass the independent check: 12 panels, 2 holes on
     // each side of each of the 24 corners, 5 score lines (4 strips) per panel.
     let sheets = check_sheets(&out, &manifest, DxfCheck::All);

@@ -16,8 +16,8 @@ use glam::DVec3;
 use tempfile::TempDir;
 
 use common::build::{
-    build, check_output, check_sheets, compare_with_golden, count, crate_dir, finish, model,
-    options, pipeline, read_manifest, resolve, unfold_command, DxfCheck, Golden,
+    build, check_output, check_sheets, count, golden_build, model, options, pipeline, resolve,
+    DxfCheck,
 };
 use unfold::config::SchemeName;
 
@@ -141,23 +141,15 @@ fn holes_of_a_connection_meet_in_3d() {
 
 #[test]
 fn golden_files_of_the_cube() {
-    let golden = crate_dir().join("tests/golden/hexahedron-winged-edge");
-    let tmp = TempDir::new().unwrap();
-    let out = tmp.path().join("hexahedron");
-    let run = finish(
-        unfold_command()
-            .current_dir(crate_dir())
-            .arg("models/hexahedron.obj")
-            .args(["--size", "150mm", "--scheme", "winged-edge", "--holes", "2"])
-            .args(["--format", "svg,dxf", "--out"])
-            .arg(&out),
-    );
-    assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let manifest = read_manifest(&out);
-    assert_eq!(manifest["input"]["path"], "models/hexahedron.obj");
-    if compare_with_golden(&out, &golden, tmp.path(), "build_winged_edge") == Golden::Rewritten {
+    let args = ["--size", "150mm", "--scheme", "winged-edge", "--holes", "2"];
+    let Some((_tmp, out, manifest)) = golden_build(
+        "build_winged_edge",
+        "hexahedron-winged-edge",
+        "hexahedron",
+        &args,
+    ) else {
         return;
-    }
+    };
     let sheets = check_sheets(&out, &manifest, DxfCheck::All);
     let total = sheets.total();
     assert_eq!(total.panels, 12);

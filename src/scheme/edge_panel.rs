@@ -138,6 +138,52 @@ pub fn place_pins(
     (Vec::new(), true)
 }
 
+/// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
+/// face order), then the panels, the connection count (one per face corner) and the
+/// report lines.
+pub fn edge_scheme(
+    mesh: &Mesh,
+    options: &SchemeOptions,
+    face_flaps: impl Fn(&Mesh, FaceId, &SchemeOptions) -> FaceFlaps + Sync,
+) -> super::SchemeOutput {
+    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
+        .into_par_iter()
+        .map(|f| face_flaps(mesh, FaceId(f), options))
+        .collect();
+    let panels = edge_panels(mesh, &faces, options);
+    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
+    super::SchemeOutput {
+        panels,
+        connections,
+        notes: edge_scheme_notes(mesh, &faces, connections, options),
+    }
+}
+
+/// Report lines shared by the edge schemes: holes that did not fit, boundary panels.
+pub fn edge_scheme_notes(
+    mesh: &Mesh,
+    faces: &[FaceFlaps],
+    connections: usize,
+    options: &SchemeOptions,
+) -> Vec<String> {
+    let reduced: usize = faces.iter().map(|f| f.reduced).sum();
+    let bare: usize = faces.iter().map(|f| f.bare).sum();
+    let mut notes = Vec::new();
+    if reduced > 0 {
+        notes.push(format!(
+            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlap cannot hold more {} mm holes with one diameter of material around each; a larger --size, smaller --hole-diameter or larger --flap-scale helps",
+            options.holes, options.hole_diameter
+        ));
+    }
+    let boundary = mesh.edges().filter(|&e| mesh.is_boundary_edge(e)).count();
+    if boundary > 0 {
+        notes.push(format!(
+            "{boundary} boundary edges have a panel with a single flap and no bend"
+        ));
+    }
+    notes
+}
+
 /// Builds every edge panel from the faces' flaps. Returns the panels (in edge order).
 pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &SchemeOptions) -> Vec<Panel> {
     let mut corner_of = vec![0u32; mesh.half_edge_count()];

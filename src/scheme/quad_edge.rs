@@ -18,9 +18,8 @@
 //! [`super::edge_panel`], shared with the winged-edge scheme.
 
 use glam::DVec2;
-use rayon::prelude::*;
 
-use super::edge_panel::{band, corner_half_edges, edge_panels, place_pins, FaceFlaps};
+use super::edge_panel::{band, corner_half_edges, edge_scheme, place_pins, FaceFlaps};
 use super::{SchemeOptions, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
 use crate::plane::clip_half_plane;
@@ -29,42 +28,7 @@ pub use super::edge_panel::panel_id;
 
 /// Builds the edge panels of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
-    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
-        .into_par_iter()
-        .map(|f| face_flaps(mesh, FaceId(f), options))
-        .collect();
-    let panels = edge_panels(mesh, &faces, options);
-    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
-    SchemeOutput {
-        panels,
-        connections,
-        notes: edge_scheme_notes(mesh, &faces, connections, options),
-    }
-}
-
-/// Report lines shared by the edge schemes: holes that did not fit, boundary panels.
-pub fn edge_scheme_notes(
-    mesh: &Mesh,
-    faces: &[FaceFlaps],
-    connections: usize,
-    options: &SchemeOptions,
-) -> Vec<String> {
-    let reduced: usize = faces.iter().map(|f| f.reduced).sum();
-    let bare: usize = faces.iter().map(|f| f.bare).sum();
-    let mut notes = Vec::new();
-    if reduced > 0 {
-        notes.push(format!(
-            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlap cannot hold more {} mm holes with one diameter of material around each; a larger --size, smaller --hole-diameter or larger --flap-scale helps",
-            options.holes, options.hole_diameter
-        ));
-    }
-    let boundary = mesh.edges().filter(|&e| mesh.is_boundary_edge(e)).count();
-    if boundary > 0 {
-        notes.push(format!(
-            "{boundary} boundary edges have a panel with a single flap and no bend"
-        ));
-    }
-    notes
+    edge_scheme(mesh, options, face_flaps)
 }
 
 /// Band, flaps and corner overlaps of one face, computed in its plane.

@@ -14,26 +14,14 @@
 //! shift 0 a corner has two shared regions (2 × holes per connection), with ±1 one.
 
 use glam::DVec2;
-use rayon::prelude::*;
 
-use super::edge_panel::{band, corner_half_edges, edge_panels, place_pins, FaceFlaps};
-use super::quad_edge::edge_scheme_notes;
+use super::edge_panel::{band, corner_half_edges, edge_scheme, place_pins, FaceFlaps};
 use super::{SchemeOptions, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
 
 /// Builds the winged edge panels of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
-    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
-        .into_par_iter()
-        .map(|f| face_flaps(mesh, FaceId(f), options))
-        .collect();
-    let panels = edge_panels(mesh, &faces, options);
-    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
-    SchemeOutput {
-        panels,
-        connections,
-        notes: edge_scheme_notes(mesh, &faces, connections, options),
-    }
+    edge_scheme(mesh, options, face_flaps)
 }
 
 fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {

@@ -572,6 +572,38 @@ pub fn job(scheme: SchemeName, model: &Path, size: &str, holes: u32, out: &Path)
 // Golden files
 // =======================================================================================
 
+/// A golden build: runs `unfold models/MODEL.obj ARGS --format svg,dxf` from the crate
+/// root (so the manifest's `input.path` is the same on every machine) and compares the
+/// output folder with `tests/golden/DIR` ([`compare_with_golden`]). Returns the temporary
+/// folder, the output folder and its manifest for further checks, or `None` when
+/// `UNFOLD_UPDATE_GOLDEN=1` rewrote the golden files.
+pub fn golden_build(
+    test: &str,
+    dir: &str,
+    model: &str,
+    args: &[&str],
+) -> Option<(tempfile::TempDir, PathBuf, Value)> {
+    let golden = crate_dir().join("tests/golden").join(dir);
+    let tmp = tempfile::TempDir::new().unwrap();
+    let out = tmp.path().join(model);
+    let path = format!("models/{model}.obj");
+    let run = finish(
+        unfold_command()
+            .current_dir(crate_dir())
+            .arg(&path)
+            .args(args)
+            .args(["--format", "svg,dxf", "--out"])
+            .arg(&out),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let manifest = read_manifest(&out);
+    assert_eq!(manifest["input"]["path"], path.as_str());
+    match compare_with_golden(&out, &golden, tmp.path(), test) {
+        Golden::Rewritten => None,
+        Golden::Matched => Some((tmp, out, manifest)),
+    }
+}
+
 /// The first line where two texts differ, for the failure message.
 pub fn first_difference(want: &[u8], got: &[u8]) -> String {
     let (want, got) = (String::from_utf8_lossy(want), String::from_utf8_lossy(got));
