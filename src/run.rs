@@ -125,8 +125,24 @@ pub fn run(job: &Job) -> Result<Outcome> {
         .collect::<std::result::Result<_, _>>()
         .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
+        // Say why when a face far from planar was kept by a loose tolerance: its panel
+        // is a projection of a warped polygon.
+        let warped = match bad.source {
+            Source::Face(f) => {
+                let corners: Vec<glam::DVec3> = mesh.face_positions(FaceId(f)).collect();
+                crate::mesh::geometry::planarity_error(&corners)
+            }
+            _ => 0.0,
+        };
+        let advice = if warped > 1e-3 {
+            format!(
+                "its face is far from planar (planarity error {warped:.3}): lower --planarity-tol so such faces are triangulated"
+            )
+        } else {
+            "try a smaller --tab-height or --flap-scale".to_string()
+        };
         return Err(Error::Runtime(format!(
-            "panel {} overlaps itself when unrolled; try a smaller --tab-height",
+            "panel {} overlaps itself when unrolled; {advice}",
             bad.id
         )));
     }
