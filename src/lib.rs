@@ -103,6 +103,17 @@ pub struct Inspection {
     pub ignored: Vec<(String, usize)>,
     /// Repairs and observations.
     pub notes: Vec<Note>,
+    /// Faces each kind of scheme would split before building panels.
+    pub preparation: Preparation,
+}
+
+/// What preparation would do before building panels, per kind of scheme.
+#[derive(Clone, Debug, Serialize)]
+pub struct Preparation {
+    /// Half-edge: faces split as non-planar, and as not star-shaped from their centre.
+    pub half_edge: [usize; 2],
+    /// Quad-edge and winged-edge: faces split as non-planar, and as not convex.
+    pub edge_schemes: [usize; 2],
 }
 
 /// Reads, checks and measures a model. Errors if it cannot be built at all.
@@ -128,7 +139,16 @@ pub fn inspect(path: &Path, settings: &ModelSettings) -> Result<Inspection> {
             ),
         });
     }
+    let split = |convex| {
+        let r = mesh::split::faces_to_split(&prepared.mesh, settings.planarity_tol, convex);
+        [r.non_planar.len(), r.not_star_shaped.len()]
+    };
+    let preparation = Preparation {
+        half_edge: split(false),
+        edge_schemes: split(true),
+    };
     Ok(Inspection {
+        preparation,
         path: path.display().to_string(),
         format: raw.format,
         input: prepared.input.clone(),
@@ -243,6 +263,12 @@ impl Inspection {
             s,
             "planarity:   max error {:.3e}; {} faces above {}",
             g.max_planarity_error, g.non_planar_faces, g.planarity_tolerance
+        );
+        let p = &self.preparation;
+        let _ = writeln!(
+            s,
+            "preparation: half-edge splits {} non-planar + {} concave faces into triangles; quad-/winged-edge split {} non-planar + {} non-convex",
+            p.half_edge[0], p.half_edge[1], p.edge_schemes[0], p.edge_schemes[1]
         );
         if !self.groups.is_empty() {
             let names: Vec<&str> = self.groups.iter().map(|g| g.name.as_str()).collect();

@@ -278,3 +278,36 @@ fn inspect_text_is_the_same_on_every_run() {
     assert!(String::from_utf8_lossy(&first).contains("genus 0"));
     assert_eq!(first, run());
 }
+
+#[test]
+fn inspect_lists_what_preparation_would_split_and_builds_agree() {
+    // The star prism's caps are star-shaped from their centre (half-edge keeps them)
+    // but not convex (the edge schemes split them).
+    let concave = manifest_dir().join("models/concave.obj");
+    let report = inspect(&concave, &[]);
+    assert_eq!(
+        report["preparation"]["half_edge"],
+        serde_json::json!([0, 0])
+    );
+    assert_eq!(
+        report["preparation"]["edge_schemes"],
+        serde_json::json!([0, 2])
+    );
+    for (scheme, key) in [("half-edge", "half_edge"), ("quad-edge", "edge_schemes")] {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("o");
+        let status = Command::new(env!("CARGO_BIN_EXE_unfold"))
+            .arg(&concave)
+            .args(["--scheme", scheme, "--size", "300mm", "--quiet", "--out"])
+            .arg(&out)
+            .status()
+            .unwrap();
+        assert!(status.success());
+        let manifest: Value =
+            serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+        let split = &manifest["input"]["faces_split"];
+        let preview = &report["preparation"][key];
+        assert_eq!(split["non_planar"], preview[0], "{scheme}");
+        assert_eq!(split["not_star_shaped"], preview[1], "{scheme}");
+    }
+}
