@@ -61,15 +61,27 @@ impl Stopwatch {
     }
 }
 
-/// Runs a job and writes its output folder (atomically: on any error the folder is
-/// left as it was).
-pub fn run(job: &Job) -> Result<Outcome> {
-    let mut clock = Stopwatch::new();
-    let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
-    let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
-    let mut mesh = prepared.mesh;
-    clock.lap("load");
+/// The mesh a scheme works on, and how it was made from the prepared one.
+#[derive(Clone, Debug)]
+pub struct SchemeMesh {
+    /// Scaled to millimetres, with the faces the scheme cannot build split.
+    pub mesh: crate::mesh::Mesh,
+    /// Which faces were split and why.
+    pub split: crate::mesh::split::SplitReport,
+    /// Millimetres per model unit.
+    pub mm_per_unit: f64,
+}
 
+/// Scales the prepared mesh to millimetres and splits the faces the job's scheme
+/// cannot build as one flat piece (non-planar; not star-shaped, or for the edge
+/// schemes not convex). With `--nonplanar error` a non-planar face is an input error
+/// pointing at its line in `raw`. Shared by [`run`] and the tests that check the
+/// pipeline stage by stage.
+pub fn scheme_mesh(
+    job: &Job,
+    raw: &crate::mesh::RawModel,
+    mut mesh: crate::mesh::Mesh,
+) -> Result<SchemeMesh> {
     let geometry = mesh.geometry_facts(job.model.planarity_tol);
     let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
     mesh.scale(mm_per_unit);
@@ -93,6 +105,30 @@ pub fn run(job: &Job) -> Result<Outcome> {
         )
         .into());
     }
+    if split.count() > 0 {
+        mesh = split_faces(&mesh, &split)
+            .map_err(|e| Error::Runtime(format!("splitting faces failed: {e}")))?;
+    }
+    Ok(SchemeMesh {
+        mesh,
+        split,
+        mm_per_unit,
+    })
+}
+
+/// Runs a job and writes its output folder (atomically: on any error the folder is
+/// left as it was).
+pub fn run(job: &Job) -> Result<Outcome> {
+    let mut clock = Stopwatch::new();
+    let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
+    let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
+    clock.lap("load");
+
+    let SchemeMesh {
+        mesh,
+        split,
+        mm_per_unit,
+    } = scheme_mesh(job, &raw, prepared.mesh)?;
     if !split.non_planar.is_empty() {
         notes.push(format!(
             "{} non-planar faces were split into triangles (planarity tolerance {})",
@@ -105,10 +141,6 @@ pub fn run(job: &Job) -> Result<Outcome> {
             "{} concave faces were split into triangles: the scheme's bands, tabs or flaps would leave them",
             split.not_star_shaped.len()
         ));
-    }
-    if split.count() > 0 {
-        mesh = split_faces(&mesh, &split)
-            .map_err(|e| Error::Runtime(format!("splitting faces failed: {e}")))?;
     }
     let topology = mesh.topology();
     clock.lap("split");

@@ -15,10 +15,10 @@ use serde_json::Value;
 use super::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
 use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
 use unfold::flatten::flatten;
-use unfold::mesh::split::{faces_to_split, split_faces, SplitReport};
+use unfold::mesh::split::SplitReport;
 use unfold::mesh::Mesh;
 use unfold::panel::{FlatPanel, Panel};
-use unfold::scheme::{build_panels, needs_convex_faces, SchemeOutput};
+use unfold::scheme::{build_panels, SchemeOutput};
 
 // =======================================================================================
 // Paths
@@ -509,19 +509,9 @@ pub struct Pipeline {
 /// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
 /// scheme, flatten.
 pub fn pipeline(job: &Job) -> Pipeline {
-    let (_raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
-    let mut mesh = prepared.mesh;
-    let geometry = mesh.geometry_facts(job.model.planarity_tol);
-    let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
-    mesh.scale(mm_per_unit);
-    let split = faces_to_split(
-        &mesh,
-        job.model.planarity_tol,
-        needs_convex_faces(job.scheme),
-    );
-    if split.count() > 0 {
-        mesh = split_faces(&mesh, &split).expect("split faces");
-    }
+    let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
+    let unfold::run::SchemeMesh { mesh, split, .. } =
+        unfold::run::scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh");
     let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
     let flat = output
         .panels
