@@ -416,6 +416,33 @@ pub struct BuildOptions {
     #[arg(long, value_name = "N")]
     pub rotations: Option<u32>,
 
+    /// Layout of panels on sheets: true-shape (outlines, tabs and flaps included;
+    /// small parts fill the gaps of large ones) or shelf (bounding boxes in rows, the
+    /// baseline other unfolders use). [default: true-shape]
+    #[arg(long, value_name = "NESTER")]
+    pub nester: Option<NesterName>,
+
+    /// Search effort of the true-shape nester, 1 to 100: samples per placement and
+    /// improvement rounds grow with it, and so does the time. [default: 5]
+    #[arg(long, value_name = "N")]
+    pub effort: Option<u32>,
+
+    /// Seed of the true-shape search; the same seed and options give the same sheets.
+    /// [default: 0]
+    #[arg(long, value_name = "N")]
+    pub seed: Option<u64>,
+
+    /// Also place panels mirrored (cut face down). Only for material without a
+    /// printed or finished side. [default: off]
+    #[arg(long)]
+    #[serde(default)]
+    pub mirror: bool,
+
+    /// Wall-clock cap on the nester's improvement, in seconds. Off by default, since a
+    /// time cap makes the result depend on the machine. [default: none]
+    #[arg(long, value_name = "SECONDS")]
+    pub time_limit: Option<f64>,
+
     /// Stroke width in the SVG files, with a unit. Laser drivers treat only hairlines
     /// as vector lines; a wider stroke is for previews. [default: 0.001in]
     #[arg(long, value_name = "LENGTH")]
@@ -424,6 +451,43 @@ pub struct BuildOptions {
     #[command(flatten)]
     #[serde(flatten)]
     pub model: ModelOptions,
+}
+
+/// Nesters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum NesterName {
+    /// True shapes: sampled bottom-left placement, then emptying the emptiest sheet.
+    TrueShape,
+    /// Bounding boxes in rows.
+    Shelf,
+}
+
+impl NesterName {
+    /// The name used on the command line and in the manifest.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NesterName::TrueShape => "true-shape",
+            NesterName::Shelf => "shelf",
+        }
+    }
+}
+
+/// Nesting settings of a job.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NestSettings {
+    /// Which nester.
+    pub nester: NesterName,
+    /// Rotation steps per turn.
+    pub rotations: u32,
+    /// Search effort.
+    pub effort: u32,
+    /// Search seed.
+    pub seed: u64,
+    /// Mirrored placements allowed.
+    pub mirror: bool,
+    /// Optional wall-clock cap (seconds).
+    pub time_limit: Option<f64>,
 }
 
 /// Connector kinds.
@@ -478,8 +542,8 @@ pub struct Job {
     pub scheme_options: crate::scheme::SchemeOptions,
     /// Non-planar face policy.
     pub nonplanar: NonPlanar,
-    /// Rotation steps for the layout.
-    pub rotations: u32,
+    /// Layout settings.
+    pub nest: NestSettings,
     /// SVG stroke width (mm).
     pub stroke_width: f64,
 }
@@ -506,6 +570,11 @@ impl BuildOptions {
             label_height: self.label_height.or(other.label_height),
             nonplanar: self.nonplanar.or(other.nonplanar),
             rotations: self.rotations.or(other.rotations),
+            nester: self.nester.or(other.nester),
+            effort: self.effort.or(other.effort),
+            seed: self.seed.or(other.seed),
+            mirror: self.mirror || other.mirror,
+            time_limit: self.time_limit.or(other.time_limit),
             stroke_width: self.stroke_width.or(other.stroke_width),
             model: self.model.or(other.model),
         }
@@ -605,6 +674,29 @@ impl BuildOptions {
                 format!("{rotations} must be between 1 and 3600"),
             ));
         }
+        let effort = self.effort.unwrap_or(5);
+        if !(1..=100).contains(&effort) {
+            return Err(usage(
+                "effort",
+                format!("{effort} must be between 1 and 100"),
+            ));
+        }
+        if let Some(t) = self.time_limit {
+            if !(t.is_finite() && t > 0.0) {
+                return Err(usage(
+                    "time-limit",
+                    format!("{t} must be a positive number of seconds"),
+                ));
+            }
+        }
+        let nest = NestSettings {
+            nester: self.nester.unwrap_or(NesterName::TrueShape),
+            rotations,
+            effort,
+            seed: self.seed.unwrap_or(0),
+            mirror: self.mirror,
+            time_limit: self.time_limit,
+        };
         let scheme_options = crate::scheme::SchemeOptions {
             face_scale,
             bridge_scale,
@@ -620,7 +712,7 @@ impl BuildOptions {
         Ok(Job {
             scheme_options,
             nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
-            rotations,
+            nest,
             stroke_width: length("stroke-width", &self.stroke_width, "0.001in")?,
             model_path: model_path.to_path_buf(),
             model: self.model.resolve()?,

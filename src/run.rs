@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use glam::DVec2;
 use rayon::prelude::*;
 
-use crate::config::{Job, NonPlanar};
+use crate::config::{Job, NesterName, NonPlanar};
 use crate::error::{Error, InputError, Result};
 use crate::export::manifest::{self, round4, Manifest};
 use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
@@ -16,6 +16,7 @@ use crate::flatten::flatten;
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
+use crate::nest::true_shape::{true_shape_layout, NestOptions};
 use crate::nest::{shelf::shelf_layout, Layout, SheetSpec};
 use crate::panel::{FlatPanel, Source};
 use crate::plane::is_simple;
@@ -191,12 +192,53 @@ pub fn run(job: &Job) -> Result<Outcome> {
         spacing: job.spacing,
     };
     let outlines: Vec<Vec<DVec2>> = flat.iter().map(|p| p.outer()).collect();
-    let layout = shelf_layout(&outlines, sheet, job.rotations).map_err(|e| {
+    let nest = job.nest;
+    let too_large = |e: crate::nest::TooLarge| {
         Error::Runtime(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
             flat[e.part].id, e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))
-    })?;
+    };
+    let shelf = shelf_layout(&outlines, sheet, nest.rotations).map_err(too_large)?;
+    let mut nesting = manifest::Nesting {
+        nester: nest.nester.as_str(),
+        effort: nest.effort,
+        seed: nest.seed,
+        rotations: nest.rotations,
+        mirror: nest.mirror,
+        time_limit: nest.time_limit,
+        shelf_sheets: shelf.sheets,
+    };
+    let mut layout = match nest.nester {
+        NesterName::Shelf => shelf,
+        NesterName::TrueShape => {
+            let searched = true_shape_layout(
+                &outlines,
+                sheet,
+                &NestOptions {
+                    rotations: nest.rotations,
+                    mirror: nest.mirror,
+                    effort: nest.effort,
+                    seed: nest.seed,
+                    time_limit: nest.time_limit.map(std::time::Duration::from_secs_f64),
+                },
+            )
+            .map_err(too_large)?;
+            // The search is a heuristic: never hand out more sheets than the baseline.
+            if shelf.sheets < searched.sheets {
+                notes.push(format!(
+                    "the true-shape search needed {} sheets and the shelf layout {}: the shelf layout is used",
+                    searched.sheets, shelf.sheets
+                ));
+                nesting.nester = NesterName::Shelf.as_str();
+                shelf
+            } else {
+                searched
+            }
+        }
+    };
+    let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
+    layout.fullest_first(&areas);
     clock.lap("nest");
 
     let name = job
@@ -270,6 +312,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         lengths,
         labels_left_out,
         sheet_entries,
+        nesting,
     );
     let json = serde_json::to_string_pretty(&manifest)
         .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
@@ -302,6 +345,7 @@ fn build_manifest(
     lengths: Lengths,
     labels_left_out: LeftOut,
     sheets: Vec<manifest::SheetEntry>,
+    nesting: manifest::Nesting,
 ) -> Manifest {
     let o = &job.scheme_options;
     let sheet = &layout.sheet;
@@ -326,7 +370,7 @@ fn build_manifest(
             x: round4(placement.translation.x),
             y: round4(placement.translation.y),
             rotation_deg: round4(placement.rotation.to_degrees()),
-            mirrored: false,
+            mirrored: placement.mirrored,
             developability_error: manifest::round_nm(p.developability_error),
         })
         .collect();
@@ -384,6 +428,7 @@ fn build_manifest(
             panel_ids_left_out: labels_left_out.panel,
             partner_ids_left_out: labels_left_out.partner,
         },
+        nesting,
         panel_area: round4(panel_area),
         utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
         lengths: manifest::Lengths {
@@ -421,6 +466,20 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         m.sheet.height,
         c.sheets_lower_bound,
         100.0 * m.utilization
+    );
+    let fills: Vec<String> = m
+        .sheets
+        .iter()
+        .map(|e| format!("{:.0}%", 100.0 * e.fill))
+        .collect();
+    let _ = writeln!(
+        s,
+        "nesting: {} (effort {}, seed {}); shelf baseline {} sheets; sheet fill {}",
+        m.nesting.nester,
+        m.nesting.effort,
+        m.nesting.seed,
+        m.nesting.shelf_sheets,
+        fills.join(" ")
     );
     let _ = writeln!(
         s,

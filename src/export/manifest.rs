@@ -118,6 +118,25 @@ pub struct Sheet {
     pub kerf: f64,
 }
 
+/// The layout search and what the baseline would have needed.
+#[derive(Clone, Debug, Serialize)]
+pub struct Nesting {
+    /// "true-shape" or "shelf" (what produced the sheets).
+    pub nester: &'static str,
+    /// Search effort.
+    pub effort: u32,
+    /// Search seed.
+    pub seed: u64,
+    /// Rotation steps per turn.
+    pub rotations: u32,
+    /// Mirrored placements allowed.
+    pub mirror: bool,
+    /// Wall-clock cap in seconds, if any.
+    pub time_limit: Option<f64>,
+    /// Sheets the shelf baseline needs for the same panels.
+    pub shelf_sheets: usize,
+}
+
 /// Counts.
 #[derive(Clone, Debug, Serialize)]
 pub struct Counts {
@@ -207,7 +226,7 @@ pub struct PanelEntry {
     pub y: f64,
     /// Rotation (degrees counter-clockwise).
     pub rotation_deg: f64,
-    /// Mirrored (never, so far).
+    /// Mirrored (cut face down; only with --mirror).
     pub mirrored: bool,
     /// Largest change of a facet edge length when unrolled (mm).
     pub developability_error: f64,
@@ -228,6 +247,8 @@ pub struct Manifest {
     pub sheet: Sheet,
     /// Counts.
     pub counts: Counts,
+    /// How the sheets were laid out.
+    pub nesting: Nesting,
     /// Total panel area (mm²).
     pub panel_area: f64,
     /// panel_area / (sheets × sheet area).

@@ -47,7 +47,7 @@ impl Mesh {
         use ConnectivityError as E;
         let nh = self.half_edge_count();
         let (nv, nf) = (self.vertex_count(), self.face_count());
-        if nh % 2 != 0 {
+        if !nh.is_multiple_of(2) {
             return Err(E::Sizes("odd number of half-edges"));
         }
         if self.half_edge_prev.len() != nh

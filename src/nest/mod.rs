@@ -4,7 +4,10 @@
 //! Coordinates on a sheet: millimetres, origin at the lower-left corner, y up (the
 //! exporters flip y for SVG).
 
+pub mod grid;
+pub mod rng;
 pub mod shelf;
+pub mod true_shape;
 
 use glam::DVec2;
 
@@ -44,16 +47,23 @@ pub struct Placement {
     pub rotation: f64,
     /// Translation after rotation (mm).
     pub translation: DVec2,
+    /// Mirrored (y negated) before the rotation: the part is cut face down.
+    pub mirrored: bool,
 }
 
 impl Placement {
     /// A part point on the sheet.
     pub fn apply(&self, p: DVec2) -> DVec2 {
-        DVec2::from_angle(self.rotation).rotate(p) + self.translation
+        self.apply_direction(p) + self.translation
     }
 
     /// A part direction on the sheet.
     pub fn apply_direction(&self, d: DVec2) -> DVec2 {
+        let d = if self.mirrored {
+            DVec2::new(d.x, -d.y)
+        } else {
+            d
+        };
         DVec2::from_angle(self.rotation).rotate(d)
     }
 }
@@ -67,6 +77,26 @@ pub struct Layout {
     pub sheets: usize,
     /// One placement per part, in part order.
     pub placements: Vec<Placement>,
+}
+
+impl Layout {
+    /// Renumbers the sheets so the fullest (by the parts' `areas`) comes first, the
+    /// emptiest last; equal sheets keep their order.
+    pub fn fullest_first(&mut self, areas: &[f64]) {
+        let mut fill = vec![0.0; self.sheets];
+        for p in &self.placements {
+            fill[p.sheet] += areas[p.part];
+        }
+        let mut order: Vec<usize> = (0..self.sheets).collect();
+        order.sort_by(|&a, &b| fill[b].total_cmp(&fill[a]).then(a.cmp(&b)));
+        let mut rank = vec![0; self.sheets];
+        for (r, &s) in order.iter().enumerate() {
+            rank[s] = r;
+        }
+        for p in &mut self.placements {
+            p.sheet = rank[p.sheet];
+        }
+    }
 }
 
 /// A part too large for the sheet.

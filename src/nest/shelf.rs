@@ -60,6 +60,7 @@ pub fn shelf_layout(
             sheet: 0,
             rotation: 0.0,
             translation: DVec2::ZERO,
+            mirrored: false,
         };
         parts.len()
     ];
@@ -104,6 +105,7 @@ pub fn shelf_layout(
             sheet: s,
             rotation: o.rotation,
             translation: corner - o.lo,
+            mirrored: false,
         };
     }
     Ok(Layout {
@@ -115,6 +117,11 @@ pub fn shelf_layout(
 
 /// The rotation (among `steps` equal steps) with the smallest bounding box that fits
 /// `max_w` × `max_h`, turned to lie flat when that also fits.
+/// The smallest bounding box of an outline among `steps` rotations (width, height).
+pub fn smallest_box(outline: &[DVec2], steps: u32) -> DVec2 {
+    orient(outline, steps, f64::INFINITY, f64::INFINITY).map_or(DVec2::ZERO, |o| o.size)
+}
+
 fn orient(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> Option<Oriented> {
     let steps = steps.max(1);
     let mut best: Option<(f64, Oriented)> = None;

@@ -56,7 +56,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
             }
             // The owner alternates with the edge index: even edges give the tab to the
             // face of half-edge 2e, odd edges to the face of 2e + 1.
-            let owner = if e.0 % 2 == 0 {
+            let owner = if e.0.is_multiple_of(2) {
                 e.half_edge()
             } else {
                 e.half_edge().twin()

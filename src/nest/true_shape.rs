@@ -1,0 +1,743 @@
+//! True-shape nesting: parts are placed by their real outlines (tabs and flaps
+//! included), so small parts fill the gaps and concavities of large ones.
+//!
+//! Collision detection is jagua-rs (every part inflated by half the spacing, the sheet
+//! grown by the same amount); the search is ours:
+//! 1. constructive: parts largest first, each into the first sheet where a sampled,
+//!    then slid, bottom-left position is free (first-fit decreasing on true shapes);
+//! 2. improvement: the emptiest sheet is emptied into the others, part by part, with a
+//!    wider search; a sheet left empty is dropped. Partial moves are kept: they only
+//!    make the emptiest sheet emptier (the second objective).
+//!
+//! Every random choice comes from one generator seeded by `seed`, and the effort is a
+//! number of samples and rounds, so the result depends on the input and the options
+//! only (the nester runs on one thread). `time_limit` is an optional cap on the
+//! improvement, and the only source of run-to-run differences when it is hit.
+
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use glam::DVec2;
+use jagua_rs::collision_detection::hazards::filter::NoFilter;
+use jagua_rs::collision_detection::CDEConfig;
+use jagua_rs::entities::{Container, Item, Layout as JLayout, PItemKey};
+use jagua_rs::geometry::fail_fast::SPSurrogateConfig;
+use jagua_rs::geometry::geo_enums::RotationRange;
+use jagua_rs::geometry::geo_traits::TransformableFrom;
+use jagua_rs::geometry::primitives::{Point, Rect, SPolygon};
+use jagua_rs::geometry::shape_modification::{ShapeModifyConfig, ShapeModifyMode};
+use jagua_rs::geometry::{AllowedOrientations, DTransformation, OriginalShape};
+use rayon::prelude::*;
+
+use super::grid::Grid;
+use super::rng::SplitMix64;
+use super::{bounds, Layout, Placement, SheetSpec, TooLarge};
+use crate::plane::{convex_hull, offset_outline};
+
+/// Search settings of the true-shape nester.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NestOptions {
+    /// Rotation steps per turn (at least 1).
+    pub rotations: u32,
+    /// Also try every part mirrored.
+    pub mirror: bool,
+    /// Search effort (1 = quick); samples and rounds grow linearly with it.
+    pub effort: u32,
+    /// Seed of the search.
+    pub seed: u64,
+    /// Optional wall-clock cap on the improvement phase.
+    pub time_limit: Option<Duration>,
+}
+
+/// Extra inflation (mm) on top of half the spacing: covers the f32 arithmetic of the
+/// collision engine and the chords of its round offset joins.
+const SAFETY: f64 = 0.02;
+
+/// Weight of the x coordinate in the bottom-left score (y counts 1).
+const LEFT_WEIGHT: f32 = 0.2;
+
+/// Consecutive parts that may fail on a sheet before the constructive phase stops
+/// trying it.
+const CLOSE_AFTER_FAILURES: u32 = 40;
+
+/// Cells of the occupancy grid along the longer side of a sheet.
+const GRID_CELLS: usize = 200;
+
+/// One part as the search sees it.
+struct Part {
+    item: Arc<Item>,
+    /// The outline point that the collision shape's origin corresponds to.
+    center: DVec2,
+    /// Area of the outline (mm²), what the sheet fill counts.
+    area: f64,
+    /// Allowed orientations with the collision shape's bounds at each (no translation).
+    orientations: Vec<Orientation>,
+}
+
+#[derive(Clone, Copy)]
+struct Orientation {
+    rotation: f32,
+    mirrored: bool,
+    lo: Point,
+    hi: Point,
+    /// The shape's pole of inaccessibility in this orientation: a point well inside
+    /// it, put on a free cell when sampling.
+    poi: Point,
+}
+
+/// A pose under search: orientation index and translation.
+#[derive(Clone, Copy, Debug)]
+struct Candidate {
+    orientation: usize,
+    x: f32,
+    y: f32,
+}
+
+/// How many of the best samples get the local search.
+const REFINED: usize = 3;
+
+/// Smallest step of the local search (mm).
+const MIN_STEP: f32 = 0.05;
+
+/// One sheet being filled.
+#[derive(Clone)]
+struct Sheet {
+    layout: JLayout,
+    /// Cells covered by the placed parts.
+    grid: Grid,
+    /// (part, key in the layout, pose).
+    parts: Vec<(usize, PItemKey, DTransformation)>,
+    area: f64,
+    failures: u32,
+}
+
+/// The search state: parts, open sheets and scratch space.
+struct Nester<'a> {
+    parts: &'a [Part],
+    container: Container,
+    bounds: Rect,
+    rng: SplitMix64,
+    samples: usize,
+    scratch: SPolygon,
+    sheets: Vec<Sheet>,
+    /// Collision checks made so far (the unit of the effort budget).
+    checks: u64,
+    /// Area of the largest part.
+    largest_area: f64,
+}
+
+/// Lays out parts (outer outlines in mm) by their true shapes.
+pub fn true_shape_layout(
+    outlines: &[Vec<DVec2>],
+    sheet: SheetSpec,
+    options: &NestOptions,
+) -> Result<Layout, TooLarge> {
+    let cde_config = CDEConfig {
+        quadtree_depth: 6,
+        cd_threshold: 16,
+        item_surrogate_config: SPSurrogateConfig {
+            n_pole_limits: [(6, 0.0), (4, 0.8), (2, 0.9)],
+            ff_pole_area_ratio: 0.05,
+            n_ff_piers: 0,
+        },
+    };
+    let half_gap = 0.5 * sheet.spacing.max(0.0);
+    // The sheet is grown by half the spacing, the parts by half the spacing plus the
+    // safety, so a part's true outline stays inside the margin and two outlines stay
+    // the spacing apart.
+    let container = {
+        let (x0, y0) = (sheet.margin - half_gap, sheet.margin - half_gap);
+        let (x1, y1) = (
+            sheet.width - sheet.margin + half_gap,
+            sheet.height - sheet.margin + half_gap,
+        );
+        let rect = Rect::try_new(x0 as f32, y0 as f32, x1 as f32, y1 as f32)
+            .expect("the usable area of a validated sheet is not empty");
+        let shape = OriginalShape {
+            shape: SPolygon::from(rect),
+            pre_transform: DTransformation::empty(),
+            modify_mode: ShapeModifyMode::Deflate,
+            modify_config: ShapeModifyConfig {
+                offset: None,
+                simplify_tolerance: None,
+                narrow_concavity_cutoff: None,
+            },
+        };
+        Container::new(shape, vec![], cde_config).expect("a rectangle is a valid container")
+    };
+    let bounds_rect = container.outer_cd().bbox();
+
+    let parts: Vec<Part> = outlines
+        .par_iter()
+        .enumerate()
+        .map(|(i, outline)| {
+            prepare_part(
+                i,
+                outline,
+                half_gap + SAFETY,
+                options,
+                &cde_config,
+                bounds_rect,
+            )
+            .ok_or_else(|| too_large(i, outline, sheet, options.rotations))
+        })
+        .collect::<Result<_, _>>()?;
+
+    let mut nester = Nester {
+        parts: &parts,
+        container,
+        bounds: bounds_rect,
+        rng: SplitMix64::new(options.seed),
+        samples: 24 * options.effort.max(1) as usize,
+        scratch: parts.first().map_or_else(
+            || SPolygon::from(bounds_rect),
+            |p| p.item.shape_cd().as_ref().clone(),
+        ),
+        sheets: Vec::new(),
+        checks: 0,
+        largest_area: parts.iter().map(|p| p.area).fold(0.0, f64::max),
+    };
+
+    // Largest first; ties by index so the order is total.
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
+    for &p in &order {
+        if !nester.place_anywhere(p) {
+            return Err(too_large(p, &outlines[p], sheet, options.rotations));
+        }
+    }
+
+    let started = Instant::now();
+    let rounds = 40 * options.effort.max(1) as usize;
+    // The improvement may spend effort/2 times the collision checks of the
+    // construction: bounded work, whatever the machine.
+    let budget = nester.checks + nester.checks * u64::from(options.effort.max(1)) / 2;
+    let mut stalled = 0;
+    for _ in 0..rounds {
+        if options
+            .time_limit
+            .is_some_and(|limit| started.elapsed() >= limit)
+            || nester.checks >= budget
+        {
+            break;
+        }
+        if nester.sheets.len() < 2 {
+            break;
+        }
+        // Move what fits out of the emptiest sheet; when nothing does, make room for
+        // its largest part on another sheet by ejecting the parts in one window there.
+        if nester.empty_emptiest_sheet() || nester.eject_and_insert() {
+            stalled = 0;
+        } else {
+            stalled += 1;
+            if stalled >= 4 * options.effort.max(1) {
+                break;
+            }
+        }
+    }
+
+    Ok(nester.finish(outlines.len(), sheet))
+}
+
+/// The collision item of a part, or `None` when no allowed orientation fits the sheet.
+fn prepare_part(
+    index: usize,
+    outline: &[DVec2],
+    inflate: f64,
+    options: &NestOptions,
+    cde_config: &CDEConfig,
+    sheet_bounds: Rect,
+) -> Option<Part> {
+    let (lo, hi) = bounds(outline.iter().copied());
+    let center = 0.5 * (lo + hi);
+    // Our own offset keeps the shapes small (at most four points per corner); where
+    // it overlaps itself (a concavity narrower than the spacing), the engine's exact
+    // buffer is used, and where f32 rounding still breaks the outline, the convex
+    // hull, which only covers more.
+    let item = make_item(
+        index,
+        &offset_outline(outline, inflate),
+        center,
+        0.0,
+        options,
+        cde_config,
+    )
+    .or_else(|| make_item(index, outline, center, inflate, options, cde_config))
+    .or_else(|| {
+        let hull = offset_outline(&convex_hull(outline), inflate);
+        make_item(index, &hull, center, 0.0, options, cde_config)
+    })
+    .expect("the grown convex hull of a panel with area is a valid polygon");
+    let shape = item.shape_cd().as_ref().clone();
+    let mut turned = shape.clone();
+    let steps = options.rotations.max(1);
+    let mut orientations = Vec::new();
+    for mirrored in [false, true] {
+        if mirrored && !options.mirror {
+            continue;
+        }
+        for k in 0..steps {
+            let rotation = (std::f64::consts::TAU * f64::from(k) / f64::from(steps)) as f32;
+            let pose = DTransformation::new(rotation, (0.0, 0.0)).with_reflection(mirrored);
+            turned.transform_from(&shape, &pose.compose());
+            let bb = turned.bbox();
+            let fits = bb.x_max - bb.x_min <= sheet_bounds.x_max - sheet_bounds.x_min
+                && bb.y_max - bb.y_min <= sheet_bounds.y_max - sheet_bounds.y_min;
+            if fits {
+                orientations.push(Orientation {
+                    rotation,
+                    mirrored,
+                    lo: Point(bb.x_min, bb.y_min),
+                    hi: Point(bb.x_max, bb.y_max),
+                    poi: turned.poi().center,
+                });
+            }
+        }
+    }
+    if orientations.is_empty() {
+        return None;
+    }
+    Some(Part {
+        item,
+        center,
+        area: crate::plane::area(outline).abs(),
+        orientations,
+    })
+}
+
+/// The jagua-rs item of an outline moved so that `center` is the origin and grown by
+/// the engine by `inflate`, or `None` when f32 rounding or the growing makes it
+/// invalid.
+fn make_item(
+    index: usize,
+    outline: &[DVec2],
+    center: DVec2,
+    inflate: f64,
+    options: &NestOptions,
+    cde_config: &CDEConfig,
+) -> Option<Arc<Item>> {
+    let mut points: Vec<Point> = Vec::with_capacity(outline.len());
+    for p in outline {
+        let q = Point((p.x - center.x) as f32, (p.y - center.y) as f32);
+        if !points.contains(&q) {
+            points.push(q);
+        }
+    }
+    let shape = SPolygon::new(points).ok()?;
+    let original = OriginalShape {
+        shape,
+        pre_transform: DTransformation::empty(),
+        modify_mode: ShapeModifyMode::Inflate,
+        modify_config: ShapeModifyConfig {
+            offset: (inflate > 0.0).then_some(inflate as f32),
+            simplify_tolerance: None,
+            narrow_concavity_cutoff: None,
+        },
+    };
+    let reflections = if options.mirror { vec![0.0] } else { vec![] };
+    let orientations = AllowedOrientations::new(RotationRange::Continuous, reflections).ok()?;
+    Item::new(
+        index,
+        index as u64,
+        original,
+        orientations,
+        None,
+        cde_config.item_surrogate_config,
+    )
+    .ok()
+    .map(Arc::new)
+}
+
+/// Marks the cells under a placed part.
+fn fill_grid(grid: &mut Grid, layout: &JLayout, key: PItemKey) {
+    let shape = layout.placed_items()[key].shape();
+    let points: Vec<(f32, f32)> = shape.vertices().iter().map(|p| (p.0, p.1)).collect();
+    grid.fill_polygon(&points);
+}
+
+fn too_large(part: usize, outline: &[DVec2], sheet: SheetSpec, rotations: u32) -> TooLarge {
+    let size = super::shelf::smallest_box(outline, rotations);
+    TooLarge {
+        part,
+        width: size.x,
+        height: size.y,
+        usable_width: sheet.usable_width(),
+        usable_height: sheet.usable_height(),
+    }
+}
+
+impl Nester<'_> {
+    /// Places a part in the first open sheet with room, or on a new sheet. `false`
+    /// only when it does not fit an empty sheet.
+    fn place_anywhere(&mut self, part: usize) -> bool {
+        for s in 0..self.sheets.len() {
+            if self.sheets[s].failures >= CLOSE_AFTER_FAILURES {
+                continue;
+            }
+            if let Some(pose) = self.search(s, part, self.samples_for(part)) {
+                self.put(s, part, pose);
+                self.sheets[s].failures = 0;
+                return true;
+            }
+            self.sheets[s].failures += 1;
+        }
+        let b = self.bounds;
+        self.sheets.push(Sheet {
+            layout: JLayout::new(self.container.clone()),
+            grid: Grid::new(b.x_min, b.y_min, b.x_max, b.y_max, GRID_CELLS),
+            parts: Vec::new(),
+            area: 0.0,
+            failures: 0,
+        });
+        let s = self.sheets.len() - 1;
+        match self.search(s, part, self.samples.max(64)) {
+            Some(pose) => {
+                self.put(s, part, pose);
+                true
+            }
+            None => {
+                self.sheets.pop();
+                false
+            }
+        }
+    }
+
+    /// Samples for a part: large parts shape a sheet more and are few, so they get
+    /// up to four times as many.
+    fn samples_for(&self, part: usize) -> usize {
+        let ratio = self.parts[part].area / self.largest_area.max(f64::MIN_POSITIVE);
+        (self.samples as f64 * (1.0 + 3.0 * ratio)) as usize
+    }
+
+    fn put(&mut self, s: usize, part: usize, pose: DTransformation) {
+        let sheet = &mut self.sheets[s];
+        let key = sheet.layout.place_item(&self.parts[part].item, pose);
+        sheet.parts.push((part, key, pose));
+        sheet.area += self.parts[part].area;
+        fill_grid(&mut sheet.grid, &sheet.layout, key);
+    }
+
+    /// The sheet with the least part area (the later one on ties).
+    fn emptiest(&self) -> usize {
+        (0..self.sheets.len())
+            .min_by(|&a, &b| {
+                self.sheets[a]
+                    .area
+                    .total_cmp(&self.sheets[b].area)
+                    .then(b.cmp(&a))
+            })
+            .expect("at least one sheet")
+    }
+
+    /// Takes parts (by slot) off sheet `s`, returning their part indices.
+    fn take_off(&mut self, s: usize, mut slots: Vec<usize>) -> Vec<usize> {
+        slots.sort_unstable();
+        let parts = self.parts;
+        let sheet = &mut self.sheets[s];
+        let mut taken = Vec::with_capacity(slots.len());
+        for &slot in slots.iter().rev() {
+            let (part, key, _) = sheet.parts.remove(slot);
+            sheet.layout.remove_item(key);
+            sheet.area -= parts[part].area;
+            taken.push(part);
+        }
+        sheet.grid.clear();
+        for &(_, key, _) in &sheet.parts {
+            fill_grid(&mut sheet.grid, &sheet.layout, key);
+        }
+        taken
+    }
+
+    /// A large-neighbourhood move: the largest part of the emptiest sheet goes onto
+    /// another sheet after the parts in a window there (about its size, at a random
+    /// place) are taken off; those then go back into any sheet but the emptiest. All
+    /// or nothing: on any failure the sheets are restored.
+    fn eject_and_insert(&mut self) -> bool {
+        if self.sheets.len() < 2 {
+            return false;
+        }
+        let target = self.emptiest();
+        let parts = self.parts;
+        let Some(slot) = (0..self.sheets[target].parts.len()).max_by(|&a, &b| {
+            let (pa, pb) = (
+                self.sheets[target].parts[a].0,
+                self.sheets[target].parts[b].0,
+            );
+            parts[pa].area.total_cmp(&parts[pb].area).then(pb.cmp(&pa))
+        }) else {
+            return false;
+        };
+        let part = self.sheets[target].parts[slot].0;
+        let mut host = self.rng.below(self.sheets.len() - 1);
+        if host >= target {
+            host += 1;
+        }
+        let reach = 0.75 * parts[part].item.shape_cd().diameter();
+        let b = self.bounds;
+        let cx = b.x_min + (b.x_max - b.x_min) * self.rng.unit() as f32;
+        let cy = b.y_min + (b.y_max - b.y_min) * self.rng.unit() as f32;
+        let window: Vec<usize> = self.sheets[host]
+            .parts
+            .iter()
+            .enumerate()
+            .filter(|(_, &(_, key, _))| {
+                let bb = self.sheets[host].layout.placed_items()[key].shape().bbox();
+                bb.x_max >= cx - reach
+                    && bb.x_min <= cx + reach
+                    && bb.y_max >= cy - reach
+                    && bb.y_min <= cy + reach
+            })
+            .map(|(k, _)| k)
+            .collect();
+        let backup = self.sheets.clone();
+        let mut ejected = self.take_off(host, window);
+        let placed = match self.search(host, part, 4 * self.samples) {
+            Some(pose) => {
+                self.put(host, part, pose);
+                true
+            }
+            None => false,
+        };
+        ejected.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
+        let all_back = placed
+            && ejected.iter().all(|&q| {
+                (0..self.sheets.len()).filter(|&s| s != target).any(|s| {
+                    match self.search(s, q, 2 * self.samples) {
+                        Some(pose) => {
+                            self.put(s, q, pose);
+                            true
+                        }
+                        None => false,
+                    }
+                })
+            });
+        if !all_back {
+            self.sheets = backup;
+            return false;
+        }
+        self.take_off(target, vec![slot]);
+        if self.sheets[target].parts.is_empty() {
+            self.sheets.remove(target);
+        }
+        true
+    }
+
+    /// Moves parts out of the emptiest sheet into the others. `true` when at least
+    /// one part moved.
+    fn empty_emptiest_sheet(&mut self) -> bool {
+        let target = self.emptiest();
+        let mut on_target: Vec<usize> = (0..self.sheets[target].parts.len()).collect();
+        let parts = self.parts;
+        on_target.sort_by(|&a, &b| {
+            let (pa, pb) = (
+                self.sheets[target].parts[a].0,
+                self.sheets[target].parts[b].0,
+            );
+            parts[pb].area.total_cmp(&parts[pa].area).then(pa.cmp(&pb))
+        });
+        let mut moved_slots = Vec::new();
+        for slot in on_target {
+            let part = self.sheets[target].parts[slot].0;
+            for s in 0..self.sheets.len() {
+                if s == target {
+                    continue;
+                }
+                if let Some(pose) = self.search(s, part, 2 * self.samples) {
+                    self.put(s, part, pose);
+                    moved_slots.push(slot);
+                    break;
+                }
+            }
+        }
+        if moved_slots.is_empty() {
+            return false;
+        }
+        self.take_off(target, moved_slots);
+        if self.sheets[target].parts.is_empty() {
+            self.sheets.remove(target);
+        }
+        true
+    }
+
+    /// The best free pose of `part` on sheet `s`: `samples` random positions drawn
+    /// from free cells, the best few refined by a local search.
+    fn search(&mut self, s: usize, part: usize, samples: usize) -> Option<DTransformation> {
+        let parts = self.parts;
+        let p = &parts[part];
+        if p.item.shape_cd().area() > 1.05 * self.sheets[s].grid.free_area() {
+            return None;
+        }
+        let mut found: Vec<(f32, Candidate)> = Vec::new();
+        let consider = |found: &mut Vec<(f32, Candidate)>, score: f32, c: Candidate| {
+            found.push((score, c));
+            found.sort_by(|a, b| a.0.total_cmp(&b.0));
+            found.truncate(REFINED);
+        };
+        for _ in 0..samples {
+            let o = self.rng.below(p.orientations.len());
+            let rng = &mut self.rng;
+            let Some((px, py)) = self.sheets[s].grid.free_point(|| rng.unit(), 32) else {
+                continue;
+            };
+            let c = self.clamp(
+                part,
+                o,
+                px - p.orientations[o].poi.0,
+                py - p.orientations[o].poi.1,
+            );
+            if let Some(score) = self.score_if_free(s, part, c) {
+                consider(&mut found, score, c);
+            }
+        }
+        // An empty sheet: also its bottom-left corner in each orientation.
+        if self.sheets[s].parts.is_empty() {
+            for o in 0..p.orientations.len() {
+                let c = self.clamp(part, o, f32::NEG_INFINITY, f32::NEG_INFINITY);
+                if let Some(score) = self.score_if_free(s, part, c) {
+                    consider(&mut found, score, c);
+                }
+            }
+        }
+        let mut best: Option<(f32, Candidate)> = None;
+        for (score, c) in found {
+            let (score, c) = self.refine(s, part, score, c);
+            if best.is_none_or(|(b, _)| score < b) {
+                best = Some((score, c));
+            }
+        }
+        best.map(|(_, c)| self.pose(part, c))
+    }
+
+    /// A candidate in orientation `o` with its bounds moved inside the sheet.
+    fn clamp(&self, part: usize, o: usize, x: f32, y: f32) -> Candidate {
+        let or = self.parts[part].orientations[o];
+        let b = self.bounds;
+        Candidate {
+            orientation: o,
+            x: x.max(b.x_min - or.lo.0).min(b.x_max - or.hi.0),
+            y: y.max(b.y_min - or.lo.1).min(b.y_max - or.hi.1),
+        }
+    }
+
+    fn pose(&self, part: usize, c: Candidate) -> DTransformation {
+        let o = self.parts[part].orientations[c.orientation];
+        DTransformation::new(o.rotation, (c.x, c.y)).with_reflection(o.mirrored)
+    }
+
+    /// Greedy local search from a free candidate: moves in eight directions and turns
+    /// by one rotation step, keeping any change that lowers the score, halving the
+    /// step when none does.
+    fn refine(
+        &mut self,
+        s: usize,
+        part: usize,
+        mut score: f32,
+        mut c: Candidate,
+    ) -> (f32, Candidate) {
+        const D: f32 = std::f32::consts::FRAC_1_SQRT_2;
+        const DIRECTIONS: [(f32, f32); 8] = [
+            (0.0, -1.0),
+            (-1.0, 0.0),
+            (-D, -D),
+            (D, -D),
+            (-D, D),
+            (1.0, 0.0),
+            (0.0, 1.0),
+            (D, D),
+        ];
+        let n_orient = self.parts[part].orientations.len();
+        let mut step = 0.25 * self.parts[part].item.shape_cd().diameter();
+        while step > MIN_STEP {
+            let mut improved = false;
+            for (dx, dy) in DIRECTIONS {
+                let next = self.clamp(part, c.orientation, c.x + dx * step, c.y + dy * step);
+                if let Some(v) = self.score_if_free(s, part, next) {
+                    if v < score - 1e-4 {
+                        (score, c) = (v, next);
+                        improved = true;
+                    }
+                }
+            }
+            if n_orient > 1 {
+                for turn in [1, n_orient - 1] {
+                    let o = (c.orientation + turn) % n_orient;
+                    let next = self.clamp(part, o, c.x, c.y);
+                    if let Some(v) = self.score_if_free(s, part, next) {
+                        if v < score - 1e-4 {
+                            (score, c) = (v, next);
+                            improved = true;
+                        }
+                    }
+                }
+            }
+            if !improved {
+                step *= 0.5;
+            }
+        }
+        (score, c)
+    }
+
+    /// The bottom-left score of a pose, or `None` when it collides.
+    fn score_if_free(&mut self, s: usize, part: usize, c: Candidate) -> Option<f32> {
+        self.checks += 1;
+        let item = &self.parts[part].item;
+        let cde = self.sheets[s].layout.cde();
+        let transform = self.pose(part, c).compose();
+        let shape = item.shape_cd();
+        if cde.detect_surrogate_collision(shape.surrogate(), &transform, &NoFilter) {
+            return None;
+        }
+        // transform_from needs a buffer of the same vertex count.
+        if self.scratch.n_vertices() != shape.n_vertices() {
+            self.scratch = shape.as_ref().clone();
+        }
+        self.scratch.transform_from(shape, &transform);
+        if cde.detect_poly_collision(&self.scratch, &NoFilter) {
+            return None;
+        }
+        let bb = self.scratch.bbox();
+        Some(bb.y_max + LEFT_WEIGHT * bb.x_max)
+    }
+
+    /// Placements in part order; sheets fullest first (ties by the order they opened).
+    fn finish(self, n: usize, sheet: SheetSpec) -> Layout {
+        let mut order: Vec<usize> = (0..self.sheets.len()).collect();
+        order.sort_by(|&a, &b| {
+            self.sheets[b]
+                .area
+                .total_cmp(&self.sheets[a].area)
+                .then(a.cmp(&b))
+        });
+        let mut placements = vec![
+            Placement {
+                part: 0,
+                sheet: 0,
+                rotation: 0.0,
+                translation: DVec2::ZERO,
+                mirrored: false,
+            };
+            n
+        ];
+        for (rank, &s) in order.iter().enumerate() {
+            for &(part, _, pose) in &self.sheets[s].parts {
+                let rotation = f64::from(pose.rotation());
+                let (tx, ty) = pose.translation();
+                let mut placement = Placement {
+                    part,
+                    sheet: rank,
+                    rotation,
+                    translation: DVec2::new(f64::from(tx), f64::from(ty)),
+                    mirrored: pose.reflected,
+                };
+                // The collision shape was centred on `center`: shift it back.
+                placement.translation -= placement.apply_direction(self.parts[part].center);
+                placements[part] = placement;
+            }
+        }
+        Layout {
+            sheet,
+            sheets: self.sheets.len(),
+            placements,
+        }
+    }
+}
