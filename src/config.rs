@@ -3,6 +3,8 @@
 //! millimetres, defaults filled in and every value checked. The command line wins over
 //! the configuration file.
 
+use crate::nest::true_shape::NestOptions;
+use crate::nest::{NestSettings, NesterName};
 use std::fmt;
 use std::path::{Path, PathBuf};
 
@@ -453,43 +455,6 @@ pub struct BuildOptions {
     pub model: ModelOptions,
 }
 
-/// Nesters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum NesterName {
-    /// True shapes: sampled bottom-left placement, then emptying the emptiest sheet.
-    TrueShape,
-    /// Bounding boxes in rows.
-    Shelf,
-}
-
-impl NesterName {
-    /// The name used on the command line and in the manifest.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            NesterName::TrueShape => "true-shape",
-            NesterName::Shelf => "shelf",
-        }
-    }
-}
-
-/// Nesting settings of a job.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NestSettings {
-    /// Which nester.
-    pub nester: NesterName,
-    /// Rotation steps per turn.
-    pub rotations: u32,
-    /// Search effort.
-    pub effort: u32,
-    /// Search seed.
-    pub seed: u64,
-    /// Mirrored placements allowed.
-    pub mirror: bool,
-    /// Optional wall-clock cap (seconds).
-    pub time_limit: Option<f64>,
-}
-
 /// Connector kinds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
@@ -691,11 +656,13 @@ impl BuildOptions {
         }
         let nest = NestSettings {
             nester: self.nester.unwrap_or(NesterName::TrueShape),
-            rotations,
-            effort,
-            seed: self.seed.unwrap_or(0),
-            mirror: self.mirror,
-            time_limit: self.time_limit,
+            search: NestOptions {
+                rotations,
+                mirror: self.mirror,
+                effort,
+                seed: self.seed.unwrap_or(0),
+                time_limit: self.time_limit.map(std::time::Duration::from_secs_f64),
+            },
         };
         let scheme_options = crate::scheme::SchemeOptions {
             face_scale,

@@ -8,7 +8,8 @@ use std::collections::{BTreeMap, VecDeque};
 use glam::{DVec2, DVec3};
 
 use crate::mesh::geometry::vector_area;
-use crate::panel::{signed_area, FacetFrame, FlatHole, FlatPanel, Panel};
+use crate::panel::{FacetFrame, FlatHole, FlatPanel, Panel};
+use crate::plane::signed_area;
 
 /// Why a panel cannot be unrolled (a bug in the scheme that made it).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

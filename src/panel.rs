@@ -212,12 +212,3 @@ impl FlatPanel {
         best.sqrt()
     }
 }
-
-/// Signed area of a polygon in the plane (positive when counter-clockwise).
-pub fn signed_area(points: &[DVec2]) -> f64 {
-    let n = points.len();
-    (0..n)
-        .map(|i| points[i].perp_dot(points[(i + 1) % n]))
-        .sum::<f64>()
-        * 0.5
-}

@@ -35,16 +35,16 @@ pub fn clip_convex(subject: &[DVec2], clip: &[DVec2]) -> Vec<DVec2> {
     out
 }
 
-/// Twice the signed area (positive counter-clockwise).
-fn twice_area(poly: &[DVec2]) -> f64 {
-    (0..poly.len())
+/// Signed area of a polygon (positive when counter-clockwise).
+pub fn signed_area(poly: &[DVec2]) -> f64 {
+    0.5 * (0..poly.len())
         .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
-        .sum()
+        .sum::<f64>()
 }
 
 /// Area of a polygon (absolute).
 pub fn area(poly: &[DVec2]) -> f64 {
-    0.5 * twice_area(poly).abs()
+    signed_area(poly).abs()
 }
 
 /// Even-odd point-in-polygon test (points on the border may go either way).
@@ -238,7 +238,7 @@ pub fn offset_outline(poly: &[DVec2], r: f64) -> Vec<DVec2> {
     while pts.len() > 1 && pts[0].distance(pts[pts.len() - 1]) <= 1e-9 {
         pts.pop();
     }
-    if twice_area(&pts) < 0.0 {
+    if signed_area(&pts) < 0.0 {
         pts.reverse();
     }
     let n = pts.len();
@@ -313,7 +313,7 @@ mod offset_tests {
         ];
         l.reverse();
         let grown = offset_outline(&l, 0.5);
-        assert!(twice_area(&grown) > 0.0 && is_simple(&grown));
+        assert!(signed_area(&grown) > 0.0 && is_simple(&grown));
         assert!(grown
             .iter()
             .any(|p| p.distance(DVec2::new(2.5, 2.5)) < 1e-12));

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use glam::DVec2;
 use rayon::prelude::*;
 
-use crate::config::{Job, NesterName, NonPlanar};
+use crate::config::{Job, NonPlanar};
 use crate::error::{Error, InputError, Result};
 use crate::export::manifest::{self, round4, Manifest};
 use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
@@ -16,8 +16,8 @@ use crate::flatten::flatten;
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
-use crate::nest::true_shape::{true_shape_layout, NestOptions};
-use crate::nest::{shelf::shelf_layout, Layout, SheetSpec};
+
+use crate::nest::{lay_out, Layout, SheetSpec};
 use crate::panel::{FlatPanel, Source};
 use crate::plane::is_simple;
 use crate::scheme::build_panels;
@@ -192,53 +192,31 @@ pub fn run(job: &Job) -> Result<Outcome> {
         spacing: job.spacing,
     };
     let outlines: Vec<Vec<DVec2>> = flat.iter().map(|p| p.outer()).collect();
-    let nest = job.nest;
     let too_large = |e: crate::nest::TooLarge| {
         Error::Runtime(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
             flat[e.part].id, e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))
     };
-    let shelf = shelf_layout(&outlines, sheet, nest.rotations).map_err(too_large)?;
-    let mut nesting = manifest::Nesting {
-        nester: nest.nester.as_str(),
-        effort: nest.effort,
-        seed: nest.seed,
-        rotations: nest.rotations,
-        mirror: nest.mirror,
-        time_limit: nest.time_limit,
-        shelf_sheets: shelf.sheets,
-    };
-    let mut layout = match nest.nester {
-        NesterName::Shelf => shelf,
-        NesterName::TrueShape => {
-            let searched = true_shape_layout(
-                &outlines,
-                sheet,
-                &NestOptions {
-                    rotations: nest.rotations,
-                    mirror: nest.mirror,
-                    effort: nest.effort,
-                    seed: nest.seed,
-                    time_limit: nest.time_limit.map(std::time::Duration::from_secs_f64),
-                },
-            )
-            .map_err(too_large)?;
-            // The search is a heuristic: never hand out more sheets than the baseline.
-            if shelf.sheets < searched.sheets {
-                notes.push(format!(
-                    "the true-shape search needed {} sheets and the shelf layout {}: the shelf layout is used",
-                    searched.sheets, shelf.sheets
-                ));
-                nesting.nester = NesterName::Shelf.as_str();
-                shelf
-            } else {
-                searched
-            }
-        }
-    };
     let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
-    layout.fullest_first(&areas);
+    let nested = lay_out(&outlines, &areas, sheet, &job.nest).map_err(too_large)?;
+    if let Some(searched) = nested.dropped_search_sheets {
+        notes.push(format!(
+            "the true-shape search needed {searched} sheets and the shelf layout {}: the shelf layout is used",
+            nested.shelf_sheets
+        ));
+    }
+    let search = &job.nest.search;
+    let nesting = manifest::Nesting {
+        nester: nested.nester.as_str(),
+        effort: search.effort,
+        seed: search.seed,
+        rotations: search.rotations,
+        mirror: search.mirror,
+        time_limit: search.time_limit.map(|t| t.as_secs_f64()),
+        shelf_sheets: nested.shelf_sheets,
+    };
+    let layout = nested.layout;
     clock.lap("nest");
 
     let name = job

@@ -5,21 +5,17 @@
 //! a bad model, 2 for bad options), nothing on stdout and never a panic. Repairs must
 //! succeed (exit 0) and be listed under `notes:` in the report.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 use tempfile::TempDir;
+
+use common::build::{finish, unfold_command, Run};
 
 // ---------------------------------------------------------------------------------------
 // Helpers
 // ---------------------------------------------------------------------------------------
-
-/// Exit code, stdout and stderr of one run.
-struct Run {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
 
 /// Writes `bytes` to `dir/name` and returns the path.
 fn write(dir: &TempDir, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
@@ -30,17 +26,7 @@ fn write(dir: &TempDir, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
 
 /// Runs `unfold inspect MODEL ARGS…`.
 fn inspect(model: &Path, args: &[&str]) -> Run {
-    let output = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .arg("inspect")
-        .arg(model)
-        .args(args)
-        .output()
-        .expect("run the unfold binary");
-    Run {
-        code: output.status.code(),
-        stdout: String::from_utf8_lossy(&output.stdout).into_owned(),
-        stderr: String::from_utf8_lossy(&output.stderr).into_owned(),
-    }
+    finish(unfold_command().arg("inspect").arg(model).args(args))
 }
 
 /// Asserts a one-line error with exit code `code` that names the model file, the line

@@ -978,19 +978,22 @@ fn check_model(
     (m, run.stderr, p, job)
 }
 
+/// The project's closed models (the open ones are `open-grid` and `open-cylinder`).
+const CLOSED_MODELS: [&str; 9] = [
+    "tetrahedron",
+    "hexahedron",
+    "octahedron",
+    "dodecahedron",
+    "icosahedron",
+    "torus-8x6",
+    "genus2",
+    "genus3",
+    "concave",
+];
+
 #[test]
 fn closed_meshes_have_a_panel_per_edge_and_two_connections_per_edge() {
-    for name in [
-        "tetrahedron",
-        "hexahedron",
-        "octahedron",
-        "dodecahedron",
-        "icosahedron",
-        "torus-8x6",
-        "genus2",
-        "genus3",
-        "concave",
-    ] {
+    for name in CLOSED_MODELS {
         let (m, report, p, _job) = check_model(&model(name), "300mm", &[], DxfCheck::All, true);
         let what = format!("{name} at 300mm");
         assert_eq!(count(&m, "input.boundary_loops"), 0, "{what}: closed");
@@ -1175,19 +1178,10 @@ fn fewer_holes_where_the_overlap_is_small() {
 #[test]
 fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
     let tmp = TempDir::new().unwrap();
-    for name in [
-        "tetrahedron",
-        "hexahedron",
-        "octahedron",
-        "dodecahedron",
-        "icosahedron",
-        "torus-8x6",
-        "genus2",
-        "genus3",
-        "concave",
-        "open-grid",
-        "open-cylinder",
-    ] {
+    for name in CLOSED_MODELS
+        .into_iter()
+        .chain(["open-grid", "open-cylinder"])
+    {
         let path = model(name);
         let job = quad_job(&path, "300mm", 2, None, None);
         let p = pipeline(&job);

@@ -2,43 +2,13 @@
 //! independently computed ones (shared models, `../shared/models/README.md`) and the
 //! construction facts of the project's own generated models.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
 
 use serde_json::Value;
 
-fn manifest_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-/// The shared models folder, or `None` (with a message) when this checkout has none.
-fn shared_models() -> Option<PathBuf> {
-    let dir = manifest_dir().join("../shared/models");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: {} is absent", dir.display());
-        None
-    }
-}
-
-/// Runs `unfold inspect --json` and returns the parsed report.
-fn inspect(path: &Path, extra: &[&str]) -> Value {
-    let output = Command::new(env!("CARGO_BIN_EXE_unfold"))
-        .arg("inspect")
-        .arg(path)
-        .arg("--json")
-        .args(extra)
-        .output()
-        .expect("run unfold");
-    assert!(
-        output.status.success(),
-        "unfold inspect {} failed: {}",
-        path.display(),
-        String::from_utf8_lossy(&output.stderr)
-    );
-    serde_json::from_slice(&output.stdout).expect("inspect --json prints JSON")
-}
+use common::build::{
+    crate_dir, finish, inspect_json as inspect, read_manifest, shared_models, unfold_command,
+};
 
 fn int(v: &Value, path: &str) -> i64 {
     let mut cur = v;
@@ -77,7 +47,9 @@ const SHARED_FACTS: &[(&str, i64, i64, i64, i64, i64)] = &[
 
 #[test]
 fn shared_models_match_their_reference_facts() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = shared_models("inspect_models") else {
+        return;
+    };
     for &(name, v, e, f, boundary, genus) in SHARED_FACTS {
         let report = inspect(&dir.join(name), &[]);
         assert_eq!(int(&report, "input.vertices"), v, "{name} V");
@@ -103,7 +75,9 @@ fn shared_models_match_their_reference_facts() {
 
 #[test]
 fn fertility_is_genus_four_with_ngons() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = shared_models("inspect_models") else {
+        return;
+    };
     let report = inspect(&dir.join("fertility.obj"), &[]);
     assert_eq!(int(&report, "mesh.genus"), 4);
     assert_eq!(int(&report, "mesh.euler_characteristic"), -6);
@@ -119,7 +93,9 @@ fn fertility_is_genus_four_with_ngons() {
 
 #[test]
 fn bunny_unreferenced_vertices_are_reported_and_dropped() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = shared_models("inspect_models") else {
+        return;
+    };
     let report = inspect(&dir.join("stanford-bunny.obj"), &[]);
     assert_eq!(int(&report, "input.vertices_in_file"), 35947);
     assert_eq!(int(&report, "mesh.vertices"), 34834);
@@ -139,7 +115,9 @@ fn bunny_unreferenced_vertices_are_reported_and_dropped() {
 
 #[test]
 fn suzanne_has_several_components_and_welding_skips_the_eyes() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = shared_models("inspect_models") else {
+        return;
+    };
     let report = inspect(&dir.join("suzanne.obj"), &[]);
     assert_eq!(report["mesh"]["components"].as_array().unwrap().len(), 3);
     let shared = notes(&report)
@@ -161,7 +139,9 @@ fn suzanne_has_several_components_and_welding_skips_the_eyes() {
 
 #[test]
 fn teapot_seams_are_reported_and_weld_where_manifold() {
-    let Some(dir) = shared_models() else { return };
+    let Some(dir) = shared_models("inspect_models") else {
+        return;
+    };
     let report = inspect(&dir.join("teapot.obj"), &[]);
     assert_eq!(int(&report, "input.euler_characteristic"), -34);
     let kinds: Vec<String> = notes(&report).into_iter().map(|(k, _)| k).collect();
@@ -194,7 +174,7 @@ const PROJECT_FACTS: &[(&str, i64, i64, i64, i64, i64, i64)] = &[
 #[test]
 fn project_models_have_their_construction_facts() {
     for &(name, v, e, f, boundary, loops, genus) in PROJECT_FACTS {
-        let report = inspect(&manifest_dir().join("models").join(name), &[]);
+        let report = inspect(&crate_dir().join("models").join(name), &[]);
         assert_eq!(int(&report, "mesh.vertices"), v, "{name} V");
         assert_eq!(int(&report, "mesh.edges"), e, "{name} E");
         assert_eq!(int(&report, "mesh.faces"), f, "{name} F");
@@ -214,10 +194,7 @@ fn project_models_have_their_construction_facts() {
 
 #[test]
 fn size_scales_the_longest_side() {
-    let report = inspect(
-        &manifest_dir().join("models/genus2.obj"),
-        &["--size", "4ft"],
-    );
+    let report = inspect(&crate_dir().join("models/genus2.obj"), &["--size", "4ft"]);
     let size: Vec<f64> = report["physical"]["size_mm"]
         .as_array()
         .unwrap()
@@ -230,7 +207,7 @@ fn size_scales_the_longest_side() {
     assert!((size[1] / longest - 0.6).abs() < 1e-9, "{size:?}");
 
     let by_units = inspect(
-        &manifest_dir().join("models/genus2.obj"),
+        &crate_dir().join("models/genus2.obj"),
         &["--units", "cm", "--scale", "2"],
     );
     let mm = by_units["physical"]["mm_per_unit"].as_f64().unwrap();
@@ -244,7 +221,7 @@ fn size_scales_the_longest_side() {
 #[test]
 fn surface_area_of_the_generated_hexahedron() {
     // A cube whose longest side is 100 model units: six 100 x 100 faces.
-    let report = inspect(&manifest_dir().join("models/hexahedron.obj"), &[]);
+    let report = inspect(&crate_dir().join("models/hexahedron.obj"), &[]);
     let area = report["geometry"]["surface_area"].as_f64().unwrap();
     assert!((area - 60000.0).abs() < 1e-6, "{area}");
 }
@@ -254,7 +231,7 @@ fn config_file_gives_options_and_the_command_line_wins() {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("unfold.toml");
     std::fs::write(&config, "size = \"1m\"\nunits = \"cm\"\n").unwrap();
-    let model = manifest_dir().join("models/genus2.obj");
+    let model = crate_dir().join("models/genus2.obj");
     let config_arg = config.to_str().unwrap();
     let from_file = inspect(&model, &["--config", config_arg]);
     let mm = from_file["physical"]["mm_per_unit"].as_f64().unwrap();
@@ -266,16 +243,10 @@ fn config_file_gives_options_and_the_command_line_wins() {
 
 #[test]
 fn inspect_text_is_the_same_on_every_run() {
-    let model = manifest_dir().join("models/concave.obj");
-    let run = || {
-        Command::new(env!("CARGO_BIN_EXE_unfold"))
-            .args(["inspect", model.to_str().unwrap()])
-            .output()
-            .unwrap()
-            .stdout
-    };
+    let model = crate_dir().join("models/concave.obj");
+    let run = || finish(unfold_command().arg("inspect").arg(&model)).stdout;
     let first = run();
-    assert!(String::from_utf8_lossy(&first).contains("genus 0"));
+    assert!(first.contains("genus 0"));
     assert_eq!(first, run());
 }
 
@@ -283,7 +254,7 @@ fn inspect_text_is_the_same_on_every_run() {
 fn inspect_lists_what_preparation_would_split_and_builds_agree() {
     // The star prism's caps are star-shaped from their centre (half-edge keeps them)
     // but not convex (the edge schemes split them).
-    let concave = manifest_dir().join("models/concave.obj");
+    let concave = crate_dir().join("models/concave.obj");
     let report = inspect(&concave, &[]);
     assert_eq!(
         report["preparation"]["half_edge"],
@@ -296,15 +267,14 @@ fn inspect_lists_what_preparation_would_split_and_builds_agree() {
     for (scheme, key) in [("half-edge", "half_edge"), ("quad-edge", "edge_schemes")] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("o");
-        let status = Command::new(env!("CARGO_BIN_EXE_unfold"))
-            .arg(&concave)
-            .args(["--scheme", scheme, "--size", "300mm", "--quiet", "--out"])
-            .arg(&out)
-            .status()
-            .unwrap();
-        assert!(status.success());
-        let manifest: Value =
-            serde_json::from_slice(&std::fs::read(out.join("manifest.json")).unwrap()).unwrap();
+        let run = finish(
+            unfold_command()
+                .arg(&concave)
+                .args(["--scheme", scheme, "--size", "300mm", "--quiet", "--out"])
+                .arg(&out),
+        );
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        let manifest = read_manifest(&out);
         let split = &manifest["input"]["faces_split"];
         let preview = &report["preparation"][key];
         assert_eq!(split["non_planar"], preview[0], "{scheme}");

@@ -14,7 +14,7 @@ use common::build::{
 };
 use unfold::nest::true_shape::{true_shape_layout, NestOptions};
 use unfold::nest::{Layout, SheetSpec};
-use unfold::plane::{contains, segment_distance};
+use unfold::plane::{contains, segment_distance, signed_area};
 
 const TOL: f64 = 1e-6;
 
@@ -164,12 +164,7 @@ fn mirrored_placements_are_valid_and_used() {
     // A mirrored placement turns a counter-clockwise outline clockwise.
     let p = layout.placements.iter().find(|p| p.mirrored).unwrap();
     let turned: Vec<DVec2> = parts[p.part].iter().map(|&q| p.apply(q)).collect();
-    let signed = |poly: &[DVec2]| -> f64 {
-        (0..poly.len())
-            .map(|i| poly[i].perp_dot(poly[(i + 1) % poly.len()]))
-            .sum()
-    };
-    assert!(signed(&parts[p.part]).signum() != signed(&turned).signum());
+    assert!(signed_area(&parts[p.part]).signum() != signed_area(&turned).signum());
 }
 
 #[test]
@@ -186,7 +181,7 @@ fn a_part_larger_than_the_sheet_is_refused() {
     ];
     let e = true_shape_layout(&parts, sheet, &options(0)).unwrap_err();
     assert_eq!(e.part, 1);
-    // Its diagonal fits when turned: a 95 mm long sliver goes on.
+    // A 110 mm sliver is longer than the usable 90 mm side but fits turned 45°.
     let parts = vec![vec![
         DVec2::ZERO,
         DVec2::new(110.0, 0.0),

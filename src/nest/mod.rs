@@ -11,6 +11,8 @@ pub mod true_shape;
 
 use glam::DVec2;
 
+use true_shape::NestOptions;
+
 /// The sheet and the clearances every layout must respect (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SheetSpec {
@@ -37,7 +39,7 @@ impl SheetSpec {
 }
 
 /// Where one part goes: rotate about the part's origin, then translate.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Placement {
     /// Index of the part in the input list.
     pub part: usize,
@@ -97,6 +99,81 @@ impl Layout {
             p.sheet = rank[p.sheet];
         }
     }
+}
+
+/// Nesters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum NesterName {
+    /// True shapes: sampled bottom-left placement, then emptying the emptiest sheet.
+    TrueShape,
+    /// Bounding boxes in rows.
+    Shelf,
+}
+
+impl NesterName {
+    /// The name used on the command line and in the manifest.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            NesterName::TrueShape => "true-shape",
+            NesterName::Shelf => "shelf",
+        }
+    }
+}
+
+/// Nesting settings of a job.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NestSettings {
+    /// Which nester.
+    pub nester: NesterName,
+    /// Rotations, mirroring and the true-shape search's effort, seed and time cap
+    /// (the shelf uses the rotations only).
+    pub search: NestOptions,
+}
+
+/// The layout of a job and how it was reached.
+#[derive(Clone, Debug)]
+pub struct Nested {
+    /// The sheets, fullest first.
+    pub layout: Layout,
+    /// The nester whose layout this is.
+    pub nester: NesterName,
+    /// Sheets of the shelf baseline for the same parts.
+    pub shelf_sheets: usize,
+    /// Sheets of the true-shape search when its result was dropped for the shelf's.
+    pub dropped_search_sheets: Option<usize>,
+}
+
+/// Lays out parts (outer outlines in mm, with their areas for the sheet order) with
+/// the chosen nester. The shelf baseline is always computed: it is what the report
+/// compares with, and the true-shape search, being a heuristic, never hands out more
+/// sheets than it.
+pub fn lay_out(
+    outlines: &[Vec<DVec2>],
+    areas: &[f64],
+    sheet: SheetSpec,
+    settings: &NestSettings,
+) -> Result<Nested, TooLarge> {
+    let shelf = shelf::shelf_layout(outlines, sheet, settings.search.rotations)?;
+    let shelf_sheets = shelf.sheets;
+    let (mut layout, nester, dropped_search_sheets) = match settings.nester {
+        NesterName::Shelf => (shelf, NesterName::Shelf, None),
+        NesterName::TrueShape => {
+            let searched = true_shape::true_shape_layout(outlines, sheet, &settings.search)?;
+            if shelf.sheets < searched.sheets {
+                (shelf, NesterName::Shelf, Some(searched.sheets))
+            } else {
+                (searched, NesterName::TrueShape, None)
+            }
+        }
+    };
+    layout.fullest_first(areas);
+    Ok(Nested {
+        layout,
+        nester,
+        shelf_sheets,
+        dropped_search_sheets,
+    })
 }
 
 /// A part too large for the sheet.

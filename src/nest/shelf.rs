@@ -54,16 +54,7 @@ pub fn shelf_layout(
         used: f64,
     }
     let mut sheets: Vec<Vec<Shelf>> = Vec::new();
-    let mut placements = vec![
-        Placement {
-            part: 0,
-            sheet: 0,
-            rotation: 0.0,
-            translation: DVec2::ZERO,
-            mirrored: false,
-        };
-        parts.len()
-    ];
+    let mut placements = vec![Placement::default(); parts.len()];
     for i in order {
         let o = oriented[i];
         let (w, h) = (o.size.x, o.size.y);

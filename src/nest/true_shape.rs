@@ -300,7 +300,7 @@ fn prepare_part(
     Some(Part {
         item,
         center,
-        area: crate::plane::area(outline).abs(),
+        area: crate::plane::area(outline),
         orientations,
     })
 }
@@ -701,31 +701,14 @@ impl Nester<'_> {
 
     /// Placements in part order; sheets fullest first (ties by the order they opened).
     fn finish(self, n: usize, sheet: SheetSpec) -> Layout {
-        let mut order: Vec<usize> = (0..self.sheets.len()).collect();
-        order.sort_by(|&a, &b| {
-            self.sheets[b]
-                .area
-                .total_cmp(&self.sheets[a].area)
-                .then(a.cmp(&b))
-        });
-        let mut placements = vec![
-            Placement {
-                part: 0,
-                sheet: 0,
-                rotation: 0.0,
-                translation: DVec2::ZERO,
-                mirrored: false,
-            };
-            n
-        ];
-        for (rank, &s) in order.iter().enumerate() {
-            for &(part, _, pose) in &self.sheets[s].parts {
-                let rotation = f64::from(pose.rotation());
+        let mut placements = vec![Placement::default(); n];
+        for (s, on_sheet) in self.sheets.iter().enumerate() {
+            for &(part, _, pose) in &on_sheet.parts {
                 let (tx, ty) = pose.translation();
                 let mut placement = Placement {
                     part,
-                    sheet: rank,
-                    rotation,
+                    sheet: s,
+                    rotation: f64::from(pose.rotation()),
                     translation: DVec2::new(f64::from(tx), f64::from(ty)),
                     mirrored: pose.reflected,
                 };
@@ -734,10 +717,13 @@ impl Nester<'_> {
                 placements[part] = placement;
             }
         }
-        Layout {
+        let mut layout = Layout {
             sheet,
             sheets: self.sheets.len(),
             placements,
-        }
+        };
+        let areas: Vec<f64> = self.parts.iter().map(|p| p.area).collect();
+        layout.fullest_first(&areas);
+        layout
     }
 }
