@@ -646,14 +646,22 @@ impl BuildOptions {
                 format!("{effort} must be between 1 and 100"),
             ));
         }
-        if let Some(t) = self.time_limit {
-            if !(t.is_finite() && t > 0.0) {
-                return Err(usage(
-                    "time-limit",
-                    format!("{t} must be a positive number of seconds"),
-                ));
-            }
-        }
+        // Duration::from_secs_f64 panics on values it cannot hold (1e300): convert
+        // with the fallible form and refuse those like zero or negative ones.
+        let time_limit = self
+            .time_limit
+            .map(|t| {
+                std::time::Duration::try_from_secs_f64(t)
+                    .ok()
+                    .filter(|d| !d.is_zero())
+                    .ok_or_else(|| {
+                        usage(
+                            "time-limit",
+                            format!("{t:?} must be a positive number of seconds, below 1e18"),
+                        )
+                    })
+            })
+            .transpose()?;
         let nest = NestSettings {
             nester: self.nester.unwrap_or(NesterName::TrueShape),
             search: NestOptions {
@@ -661,7 +669,7 @@ impl BuildOptions {
                 mirror: self.mirror,
                 effort,
                 seed: self.seed.unwrap_or(0),
-                time_limit: self.time_limit.map(std::time::Duration::from_secs_f64),
+                time_limit,
             },
         };
         let scheme_options = crate::scheme::SchemeOptions {

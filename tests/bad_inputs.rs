@@ -688,6 +688,32 @@ fn bad_option_wins_over_json() {
     assert_error("--json on index 0", &run, 3, &bad, Some(4), &["index 0"]);
 }
 
+#[test]
+fn nesting_options_out_of_range_are_usage_errors_and_write_nothing() {
+    let dir = TempDir::new().unwrap();
+    let model = good_model(&dir);
+    let out = dir.path().join("out");
+    for (args, says) in [
+        (&["--time-limit", "1e300"][..], "--time-limit"),
+        (&["--time-limit", "0"], "--time-limit"),
+        (&["--time-limit=-2"], "--time-limit"),
+        (&["--time-limit", "nan"], "--time-limit"),
+        (&["--effort", "0"], "--effort"),
+        (&["--effort", "101"], "--effort"),
+        (&["--nester", "tight"], "--nester"),
+    ] {
+        let run = finish(
+            unfold_command()
+                .arg(&model)
+                .args(["--size", "100mm", "--out"])
+                .arg(&out)
+                .args(args),
+        );
+        assert_usage_error(&format!("{args:?}"), &run, &[says]);
+        assert!(!out.exists(), "{args:?}: the output folder was created");
+    }
+}
+
 // ---------------------------------------------------------------------------------------
 // A good model
 // ---------------------------------------------------------------------------------------
