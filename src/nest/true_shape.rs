@@ -58,6 +58,9 @@ const LEFT_WEIGHT: f32 = 0.2;
 
 /// Consecutive parts that may fail on a sheet before the constructive phase stops
 /// trying it.
+/// How far (mm) inside the sheet's bounds a clamped candidate stays.
+const EDGE_GAP: f32 = 0.01;
+
 const CLOSE_AFTER_FAILURES: u32 = 40;
 
 /// Cells of the occupancy grid along the longer side of a sheet.
@@ -119,6 +122,8 @@ struct Nester<'a> {
     rng: SplitMix64,
     samples: usize,
     scratch: SPolygon,
+    /// The part `scratch` was cloned from (its surrogate and cached facts match).
+    scratch_part: usize,
     sheets: Vec<Sheet>,
     /// Collision checks made so far (the unit of the effort budget).
     checks: u64,
@@ -193,6 +198,7 @@ pub fn true_shape_layout(
             || SPolygon::from(bounds_rect),
             |p| p.item.shape_cd().as_ref().clone(),
         ),
+        scratch_part: 0,
         sheets: Vec::new(),
         checks: 0,
         largest_area: parts.iter().map(|p| p.area).fold(0.0, f64::max),
@@ -612,10 +618,13 @@ impl Nester<'_> {
     fn clamp(&self, part: usize, o: usize, x: f32, y: f32) -> Candidate {
         let or = self.parts[part].orientations[o];
         let b = self.bounds;
+        // A hair inside the sheet's bounds: a part touching the container's edge in
+        // f32 counts as colliding with it.
+        let gap = EDGE_GAP;
         Candidate {
             orientation: o,
-            x: x.max(b.x_min - or.lo.0).min(b.x_max - or.hi.0),
-            y: y.max(b.y_min - or.lo.1).min(b.y_max - or.hi.1),
+            x: x.max(b.x_min - or.lo.0 + gap).min(b.x_max - or.hi.0 - gap),
+            y: y.max(b.y_min - or.lo.1 + gap).min(b.y_max - or.hi.1 - gap),
         }
     }
 
@@ -687,9 +696,11 @@ impl Nester<'_> {
         if cde.detect_surrogate_collision(shape.surrogate(), &transform, &NoFilter) {
             return None;
         }
-        // transform_from needs a buffer of the same vertex count.
-        if self.scratch.n_vertices() != shape.n_vertices() {
+        // transform_from needs a buffer cloned from the same part: it keeps the
+        // buffer's surrogate layout and cached facts.
+        if self.scratch_part != part {
             self.scratch = shape.as_ref().clone();
+            self.scratch_part = part;
         }
         self.scratch.transform_from(shape, &transform);
         if cde.detect_poly_collision(&self.scratch, &NoFilter) {
