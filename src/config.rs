@@ -335,7 +335,7 @@ impl ModelOptions {
 #[derive(Clone, Debug, Default, Deserialize, clap::Args)]
 #[serde(deny_unknown_fields, rename_all = "kebab-case")]
 pub struct BuildOptions {
-    /// Panel scheme (half-edge is the one built so far). [default: half-edge]
+    /// Panel scheme: half-edge, quad-edge, winged-edge or woven. [default: half-edge]
     #[arg(long, value_name = "SCHEME")]
     pub scheme: Option<SchemeName>,
 
@@ -362,9 +362,21 @@ pub struct BuildOptions {
     pub format: Option<String>,
 
     /// Face band scale s: each panel corner moves toward the face centre,
-    /// s·v + (1−s)·c. [default: 1 for half-edge, 0.5 for quad-edge]
+    /// s·v + (1−s)·c. [default: 1 for half-edge, 0.5 for quad-edge and winged-edge,
+    /// 0.8 for woven (below 1: the crossings lie between the face bands)]
     #[arg(long, value_name = "S")]
     pub face_scale: Option<f64>,
+
+    /// Strand width (woven): a strand's end covers this fraction of the face band's
+    /// side, below 1. [default: 0.4]
+    #[arg(long, value_name = "T")]
+    pub band_scale: Option<f64>,
+
+    /// Material thickness (woven), with a unit: the two strands at a crossing are this
+    /// far apart, one lifted and one lowered by half of it; 0 for flat ribbons.
+    /// [default: 0.1in]
+    #[arg(long, value_name = "LENGTH")]
+    pub thickness: Option<String>,
 
     /// Edge band control points (quad-edge): b·v + (1−b)·m toward the edge midpoint m;
     /// smaller b makes the bend rounder. [default: 0.5]
@@ -524,6 +536,8 @@ impl BuildOptions {
             out: self.out.or(other.out),
             format: self.format.or(other.format),
             face_scale: self.face_scale.or(other.face_scale),
+            band_scale: self.band_scale.or(other.band_scale),
+            thickness: self.thickness.or(other.thickness),
             bridge_scale: self.bridge_scale.or(other.bridge_scale),
             flap_scale: self.flap_scale.or(other.flap_scale),
             samples: self.samples.or(other.samples),
@@ -603,12 +617,39 @@ impl BuildOptions {
         let face_scale = fraction(
             "face-scale",
             self.face_scale,
-            if scheme == SchemeName::HalfEdge {
-                1.0
-            } else {
-                0.5
+            match scheme {
+                SchemeName::HalfEdge => 1.0,
+                SchemeName::Woven => 0.8,
+                _ => 0.5,
             },
         )?;
+        let band_scale = fraction("band-scale", self.band_scale, 0.4)?;
+        if scheme == SchemeName::Woven {
+            if face_scale >= 1.0 {
+                return Err(usage(
+                    "face-scale",
+                    "woven needs a face scale below 1: the strands cross in the gap between the face bands".to_string(),
+                ));
+            }
+            if band_scale >= 1.0 {
+                return Err(usage(
+                    "band-scale",
+                    "woven needs a band scale below 1: a strand's end must stay clear of the band corner".to_string(),
+                ));
+            }
+        }
+        let thickness = {
+            let text = self.thickness.as_deref().unwrap_or("0.1in");
+            let mm = parse_length(text).map_err(|e| usage("thickness", e))?;
+            if mm >= 0.0 && mm.is_finite() {
+                mm
+            } else {
+                return Err(usage(
+                    "thickness",
+                    format!("'{text}' must be zero or positive"),
+                ));
+            }
+        };
         let bridge_scale = fraction("bridge-scale", self.bridge_scale, 0.5)?;
         let flap_scale = fraction("flap-scale", self.flap_scale, 0.5)?;
         let samples = self.samples.unwrap_or(4);
@@ -624,6 +665,7 @@ impl BuildOptions {
         }
         let (holes, allowed): (u32, &[u32]) = match scheme {
             SchemeName::HalfEdge => (self.holes.unwrap_or(0), &[0, 1, 2]),
+            SchemeName::Woven => (self.holes.unwrap_or(2), &[0, 1, 2]),
             _ => (self.holes.unwrap_or(2), &[0, 1, 2, 4]),
         };
         if !allowed.contains(&holes) {
@@ -683,6 +725,13 @@ impl BuildOptions {
             holes,
             hole_diameter: length("hole-diameter", &self.hole_diameter, "0.125in")?,
             label_height: length("label-height", &self.label_height, "4mm")?,
+            band_scale,
+            thickness,
+            panel_limit: Some(crate::scheme::PanelLimit {
+                width: sheet.width - 2.0 * margin,
+                height: sheet.height - 2.0 * margin,
+                rotations,
+            }),
         };
         Ok(Job {
             scheme_options,

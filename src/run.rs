@@ -146,8 +146,14 @@ pub fn run(job: &Job) -> Result<Outcome> {
     let topology = mesh.topology();
     clock.lap("split");
 
-    let output = build_panels(job.scheme, &mesh, &job.scheme_options)
-        .map_err(|e| Error::Usage(e.to_string()))?;
+    let output = build_panels(job.scheme, &mesh, &job.scheme_options).map_err(|e| {
+        let message = format!("{}: {e}", job.model_path.display());
+        if e.is_usage() {
+            Error::Usage(message)
+        } else {
+            Error::Runtime(message)
+        }
+    })?;
     notes.extend(output.notes.iter().cloned());
     clock.lap("scheme");
 
@@ -401,7 +407,7 @@ fn build_manifest(
             sheets_lower_bound: lower_bound,
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
-            cycles: 0,
+            cycles: output.cycles.len(),
             labels_left_out: labels_left_out.total(),
             panel_ids_left_out: labels_left_out.panel,
             partner_ids_left_out: labels_left_out.partner,
@@ -414,6 +420,16 @@ fn build_manifest(
             score: round4(lengths.score),
             engrave: round4(lengths.engrave),
         },
+        cycles: output
+            .cycles
+            .iter()
+            .map(|c| manifest::CycleEntry {
+                id: format!("C{}", c.id),
+                edges: c.edges,
+                length: round4(c.length),
+                segments: c.segments,
+            })
+            .collect(),
         max_developability_error: manifest::round_nm(
             flat.iter()
                 .map(|p| p.developability_error)
@@ -445,6 +461,18 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         c.sheets_lower_bound,
         100.0 * m.utilization
     );
+    if !m.cycles.is_empty() {
+        let edges = m.cycles.iter().map(|y| y.edges);
+        let (lo, hi) = (edges.clone().min().unwrap_or(0), edges.max().unwrap_or(0));
+        let length: f64 = m.cycles.iter().map(|y| y.length).sum();
+        let segments: usize = m.cycles.iter().map(|y| y.segments).sum();
+        let _ = writeln!(
+            s,
+            "weave: {} cycles of {lo} to {hi} edges, {:.0} mm of ribbon in all, cut into {segments} segments",
+            m.cycles.len(),
+            length
+        );
+    }
     let fills: Vec<String> = m
         .sheets
         .iter()

@@ -232,6 +232,19 @@ pub struct PanelEntry {
     pub developability_error: f64,
 }
 
+/// One woven cycle.
+#[derive(Clone, Debug, Serialize)]
+pub struct CycleEntry {
+    /// `C3`.
+    pub id: String,
+    /// Mesh edges it crosses.
+    pub edges: usize,
+    /// Centre-line length of its ribbon (mm).
+    pub length: f64,
+    /// Segments it is cut into (panels `C3.1` …).
+    pub segments: usize,
+}
+
 /// The whole manifest.
 #[derive(Clone, Debug, Serialize)]
 pub struct Manifest {
@@ -257,6 +270,9 @@ pub struct Manifest {
     pub lengths: Lengths,
     /// Largest developability error of any panel (mm).
     pub max_developability_error: f64,
+    /// Woven cycles (woven scheme only).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub cycles: Vec<CycleEntry>,
     /// The output sheets.
     pub sheets: Vec<SheetEntry>,
     /// Every panel.

@@ -156,6 +156,7 @@ pub fn edge_scheme(
         panels,
         connections,
         notes: edge_scheme_notes(mesh, &faces, connections, options),
+        cycles: Vec::new(),
     }
 }
 

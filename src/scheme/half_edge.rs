@@ -96,6 +96,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
         panels,
         connections,
         notes,
+        cycles: Vec::new(),
     }
 }
 

@@ -7,6 +7,7 @@ pub mod edge_panel;
 pub mod half_edge;
 pub mod quad_edge;
 pub mod winged_edge;
+pub mod woven;
 
 use glam::DVec3;
 
@@ -38,6 +39,25 @@ pub struct SchemeOptions {
     pub hole_diameter: f64,
     /// Wanted label cap height (mm).
     pub label_height: f64,
+    /// Strand width as a fraction of the band side (woven).
+    pub band_scale: f64,
+    /// Material thickness (mm): woven strands cross this far apart.
+    pub thickness: f64,
+    /// The largest panel the layout can take; schemes that can cut long panels
+    /// (woven ribbons) cut them to fit. `None`: no limit.
+    pub panel_limit: Option<PanelLimit>,
+}
+
+/// The largest panel a sheet takes: its bounding box in one of `rotations` equal
+/// rotation steps must fit `width` × `height` (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanelLimit {
+    /// Usable width (mm).
+    pub width: f64,
+    /// Usable height (mm).
+    pub height: f64,
+    /// Rotation steps allowed (360°/N each).
+    pub rotations: u32,
 }
 
 /// What a scheme produced.
@@ -49,14 +69,27 @@ pub struct SchemeOutput {
     pub connections: usize,
     /// Observations for the report (tabs shortened or left out, holes skipped).
     pub notes: Vec<String>,
+    /// Woven cycles (empty for the other schemes).
+    pub cycles: Vec<woven::CycleSummary>,
 }
 
 /// Errors a scheme reports (options it cannot honour).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SchemeError {
-    /// The scheme exists in the command line but not yet in the tool.
-    #[error("the {0} scheme is not implemented yet in this version; use --scheme half-edge, quad-edge or winged-edge")]
-    NotImplemented(SchemeName),
+    /// The weave cannot be traced (a mesh with boundary).
+    #[error("the woven scheme cannot weave this mesh: {0}; close the holes of the mesh or use another --scheme")]
+    Weave(String),
+    /// A ribbon piece larger than the largest panel the sheet takes.
+    #[error("cycle {cycle}: one edge crossing of its ribbon is {size:.1} mm across and does not fit the sheet; use a larger --sheet or a smaller --size")]
+    TooLarge { cycle: String, size: f64 },
+}
+
+impl SchemeError {
+    /// True when the job's options are at fault (exit code 2); otherwise the model
+    /// does not suit the scheme at this size.
+    pub fn is_usage(&self) -> bool {
+        matches!(self, SchemeError::Weave(_))
+    }
 }
 
 /// True when the scheme needs convex faces (its flaps follow the neighbouring band
@@ -75,7 +108,7 @@ pub fn build_panels(
         SchemeName::HalfEdge => Ok(half_edge::panels(mesh, options)),
         SchemeName::QuadEdge => Ok(quad_edge::panels(mesh, options)),
         SchemeName::WingedEdge => Ok(winged_edge::panels(mesh, options)),
-        other => Err(SchemeError::NotImplemented(other)),
+        SchemeName::Woven => woven::panels(mesh, options),
     }
 }
 
