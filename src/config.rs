@@ -372,6 +372,12 @@ pub struct BuildOptions {
     #[arg(long, value_name = "T")]
     pub band_scale: Option<f64>,
 
+    /// Curl limit (woven): a ribbon segment's convex hull is at most this many times
+    /// its area. Smaller cuts ribbons into more, straighter segments that nest on
+    /// fewer sheets; larger gives fewer joints. [default: 3]
+    #[arg(long, value_name = "R")]
+    pub curl_limit: Option<f64>,
+
     /// Material thickness (woven), with a unit: the two strands at a crossing are this
     /// far apart, one lifted and one lowered by half of it; 0 for flat ribbons.
     /// [default: 0.1in]
@@ -538,6 +544,7 @@ impl BuildOptions {
             face_scale: self.face_scale.or(other.face_scale),
             band_scale: self.band_scale.or(other.band_scale),
             thickness: self.thickness.or(other.thickness),
+            curl_limit: self.curl_limit.or(other.curl_limit),
             bridge_scale: self.bridge_scale.or(other.bridge_scale),
             flap_scale: self.flap_scale.or(other.flap_scale),
             samples: self.samples.or(other.samples),
@@ -638,6 +645,13 @@ impl BuildOptions {
                 ));
             }
         }
+        let curl_limit = self.curl_limit.unwrap_or(3.0);
+        if !(curl_limit.is_finite() && curl_limit >= 1.5) {
+            return Err(usage(
+                "curl-limit",
+                format!("{curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"),
+            ));
+        }
         let thickness = {
             let text = self.thickness.as_deref().unwrap_or("0.1in");
             let mm = parse_length(text).map_err(|e| usage("thickness", e))?;
@@ -727,6 +741,7 @@ impl BuildOptions {
             label_height: length("label-height", &self.label_height, "4mm")?,
             band_scale,
             thickness,
+            curl_limit,
             panel_limit: Some(crate::scheme::PanelLimit {
                 width: sheet.width - 2.0 * margin,
                 height: sheet.height - 2.0 * margin,

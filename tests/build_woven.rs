@@ -283,6 +283,7 @@ fn a_mesh_with_holes_or_bad_woven_options_are_refused() {
         ("--band-scale", "0"),
         ("--thickness", "-1mm"),
         ("--holes", "4"),
+        ("--curl-limit", "1"),
     ] {
         let arg = format!("{option}={value}");
         let run = refused("tetrahedron", &[&arg]);
@@ -306,6 +307,26 @@ fn flat_ribbons_without_thickness_have_no_turns() {
             panel.id
         );
     }
+}
+
+#[test]
+fn a_tighter_curl_limit_cuts_straighter_segments() {
+    let tmp = TempDir::new().unwrap();
+    let mut segments = Vec::new();
+    for limit in ["3", "1.5"] {
+        let out = tmp.path().join(limit);
+        let arg = format!("--curl-limit={limit}");
+        let m = build("woven", &model("torus-8x6"), "12in", &out, &[&arg]);
+        assert_eq!(
+            m["scheme"]["params"]["curl_limit"].as_f64(),
+            Some(limit.parse().unwrap())
+        );
+        segments.push(count(&m, "counts.panels"));
+    }
+    assert!(
+        segments[1] > segments[0],
+        "curl limit 1.5 gives more segments than 3: {segments:?}"
+    );
 }
 
 #[test]

@@ -97,6 +97,12 @@ pub struct SchemeParams {
     pub hole_diameter: f64,
     /// Wanted label cap height (mm).
     pub label_height: f64,
+    /// Strand width fraction (woven).
+    pub band_scale: f64,
+    /// Material thickness (mm) between crossing strands (woven).
+    pub thickness: f64,
+    /// Largest ratio of a segment's convex hull to its area (woven).
+    pub curl_limit: f64,
     /// Millimetres per model unit.
     pub mm_per_model_unit: f64,
 }

@@ -43,6 +43,9 @@ pub struct SchemeOptions {
     pub band_scale: f64,
     /// Material thickness (mm): woven strands cross this far apart.
     pub thickness: f64,
+    /// A woven segment's convex hull is at most this many times its area: curling
+    /// ribbons are cut into pieces that nest.
+    pub curl_limit: f64,
     /// The largest panel the layout can take; schemes that can cut long panels
     /// (woven ribbons) cut them to fit. `None`: no limit.
     pub panel_limit: Option<PanelLimit>,

@@ -50,11 +50,6 @@ const OVERLAP_AREA: f64 = 1e-4;
 /// rounding.
 const FIT_SLACK: f64 = 0.5;
 
-/// A segment's convex hull is at most this many times its area: a ribbon that curls
-/// is cut where it starts to enclose more sheet than it covers, so that its segments
-/// nest closely.
-const HULL_RATIO: f64 = 3.0;
-
 /// Smallest cosine between a face normal and an edge piece's normal used to scale a
 /// lift (a fold sharper than about 78° from flat lifts by at most five times r/2).
 const MIN_LIFT_COSINE: f64 = 0.2;
@@ -683,6 +678,14 @@ fn fits(points: &[DVec2], limit: &PanelLimit) -> bool {
     any && ((size.x <= w && size.y <= h) || (size.x <= h && size.y <= w))
 }
 
+/// What a segment must respect besides not overlapping itself.
+struct Limits {
+    /// The largest panel a sheet takes.
+    panel: Option<PanelLimit>,
+    /// Largest ratio of its convex hull to its area.
+    curl: f64,
+}
+
 /// The face pieces of corner `i` (without its edge piece), as ring indices.
 fn face_part(ribbon: &Ribbon, i: usize) -> std::ops::Range<usize> {
     let all = ribbon.corner_pieces(i);
@@ -693,7 +696,8 @@ fn face_part(ribbon: &Ribbon, i: usize) -> std::ops::Range<usize> {
 /// overlap and fits: the segment holds corners `start ..= start + len` (all of their
 /// face pieces, and the edge pieces between them). `0` when not even one edge
 /// crossing fits.
-fn longest_run(ribbon: &Ribbon, start: usize, most: usize, limit: Option<&PanelLimit>) -> usize {
+fn longest_run(ribbon: &Ribbon, start: usize, most: usize, limits: &Limits) -> usize {
+    let limit = limits.panel.as_ref();
     let n = ribbon.edge_count();
     let first = face_part(ribbon, start);
     let mut chain = Unrolled::new(ribbon, first.start);
@@ -708,7 +712,7 @@ fn longest_run(ribbon: &Ribbon, start: usize, most: usize, limit: Option<&PanelL
             break;
         }
         let points = chain.points();
-        let curls = len > 0 && crate::plane::area(&convex_hull(&points)) > HULL_RATIO * chain.area;
+        let curls = len > 0 && crate::plane::area(&convex_hull(&points)) > limits.curl * chain.area;
         if curls || limit.is_some_and(|l| !fits(&points, l)) {
             break;
         }
@@ -720,13 +724,13 @@ fn longest_run(ribbon: &Ribbon, start: usize, most: usize, limit: Option<&PanelL
 /// Cuts a ring into segments: `(first corner, corners spanned)` each, fewest segments
 /// over the start positions tried (ties: the earliest start). `None` when one edge
 /// crossing alone does not fit.
-fn plan_segments(ribbon: &Ribbon, limit: Option<&PanelLimit>) -> Option<Vec<(usize, usize)>> {
+fn plan_segments(ribbon: &Ribbon, limits: &Limits) -> Option<Vec<(usize, usize)>> {
     let n = ribbon.edge_count();
     let greedy = |start: usize| -> Option<Vec<(usize, usize)>> {
         let mut plan = Vec::new();
         let mut done = 0;
         while done < n {
-            let len = longest_run(ribbon, (start + done) % n, n - done, limit);
+            let len = longest_run(ribbon, (start + done) % n, n - done, limits);
             if len == 0 {
                 return None;
             }
@@ -754,10 +758,14 @@ fn plan_segments(ribbon: &Ribbon, limit: Option<&PanelLimit>) -> Option<Vec<(usi
 /// Builds the woven panels: one per segment of every cycle's ribbon.
 pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, SchemeError> {
     let (ribbons, ribbon_notes) = ribbons(mesh, options)?;
+    let limits = Limits {
+        panel: options.panel_limit,
+        curl: options.curl_limit,
+    };
     let plans: Vec<Vec<(usize, usize)>> = ribbons
         .par_iter()
         .map(|r| {
-            plan_segments(r, options.panel_limit.as_ref()).ok_or_else(|| {
+            plan_segments(r, &limits).ok_or_else(|| {
                 let first: Vec<DVec3> = r.lines.iter().take(6).flatten().copied().collect();
                 SchemeError::TooLarge {
                     cycle: cycle_id(r.cycle),
