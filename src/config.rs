@@ -655,14 +655,22 @@ impl BuildOptions {
         let thickness = {
             let text = self.thickness.as_deref().unwrap_or("0.1in");
             let mm = parse_length(text).map_err(|e| usage("thickness", e))?;
-            if mm >= 0.0 && mm.is_finite() {
-                mm
-            } else {
+            // Material thicker than the sheet is wide is a typo (1e300mm would also
+            // overflow the ribbon geometry).
+            let widest = sheet.width.min(sheet.height);
+            if !(mm >= 0.0 && mm.is_finite()) {
                 return Err(usage(
                     "thickness",
                     format!("'{text}' must be zero or positive"),
                 ));
             }
+            if mm >= widest {
+                return Err(usage(
+                    "thickness",
+                    format!("'{text}' is not below the sheet's shorter side ({widest:.1} mm); it is the material's thickness"),
+                ));
+            }
+            mm
         };
         let bridge_scale = fraction("bridge-scale", self.bridge_scale, 0.5)?;
         let flap_scale = fraction("flap-scale", self.flap_scale, 0.5)?;

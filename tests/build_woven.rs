@@ -282,6 +282,7 @@ fn a_mesh_with_holes_or_bad_woven_options_are_refused() {
         ("--band-scale", "1"),
         ("--band-scale", "0"),
         ("--thickness", "-1mm"),
+        ("--thickness", "1e300mm"),
         ("--holes", "4"),
         ("--curl-limit", "1"),
     ] {
