@@ -92,20 +92,15 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
     let mut points = vec![DVec2::NAN; panel.vertices.len()];
     let mut frames: Vec<Option<FacetFrame>> = vec![None; panel.facets.len()];
     let mut queue = VecDeque::new();
-    // The x axis of a frame is the facet edge projected into the facet's plane, so the
-    // frame is orthonormal even for a facet that is only nearly planar, and
-    // `to_3d(to_2d(p))` is the projection of p onto the facet's plane.
-    let in_plane = |e: DVec3, n: DVec3| (e - e.dot(n) * n).normalize();
     if let Some(first) = panel.facets.first() {
-        let o = panel.vertices[first[0] as usize];
-        let x3 = in_plane(panel.vertices[first[1] as usize] - o, normals[0]);
-        frames[0] = Some(FacetFrame {
-            origin3: o,
-            x3,
-            y3: normals[0].cross(x3),
-            origin2: DVec2::ZERO,
-            x2: DVec2::X,
-        });
+        let (a, b) = (first[0] as usize, first[1] as usize);
+        frames[0] = Some(FacetFrame::on_hinge(
+            panel.vertices[a],
+            panel.vertices[b],
+            normals[0],
+            DVec2::ZERO,
+            DVec2::X,
+        ));
         queue.push_back(0usize);
     }
     while let Some(f) = queue.pop_front() {
@@ -122,16 +117,14 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
             }
             // Rotate g about the hinge: its frame sits on the hinge, whose ends are
             // already placed by f.
-            let (pa, pb) = (panel.vertices[a as usize], panel.vertices[b as usize]);
-            let x3 = in_plane(pb - pa, normals[g]);
-            let (qa, qb) = (points[a as usize], points[b as usize]);
-            frames[g] = Some(FacetFrame {
-                origin3: pa,
-                x3,
-                y3: normals[g].cross(x3),
-                origin2: qa,
-                x2: (qb - qa).normalize(),
-            });
+            let (a, b) = (a as usize, b as usize);
+            frames[g] = Some(FacetFrame::on_hinge(
+                panel.vertices[a],
+                panel.vertices[b],
+                normals[g],
+                points[a],
+                points[b],
+            ));
             queue.push_back(g);
         }
     }

@@ -108,6 +108,22 @@ pub struct FacetFrame {
 }
 
 impl FacetFrame {
+    /// The frame of a facet with unit normal `normal` whose edge `pa → pb` (3D) lies
+    /// on `qa → qb` in the plane (the same length). The x axis is the edge projected
+    /// into the facet's plane, so the frame is orthonormal even for a facet that is only
+    /// nearly planar, and `to_3d(to_2d(p))` is the projection of p onto that plane.
+    pub fn on_hinge(pa: DVec3, pb: DVec3, normal: DVec3, qa: DVec2, qb: DVec2) -> Self {
+        let edge = pb - pa;
+        let x3 = (edge - edge.dot(normal) * normal).normalize();
+        FacetFrame {
+            origin3: pa,
+            x3,
+            y3: normal.cross(x3),
+            origin2: qa,
+            x2: (qb - qa).normalize(),
+        }
+    }
+
     /// The y axis in the plane (x rotated by +90°: the unrolling keeps orientation).
     pub fn y2(&self) -> DVec2 {
         self.x2.perp()

@@ -42,6 +42,15 @@ pub fn signed_area(poly: &[DVec2]) -> f64 {
         .sum::<f64>()
 }
 
+/// The polygon's corners in counter-clockwise order (reversed when clockwise).
+pub fn counter_clockwise(poly: &[DVec2]) -> Vec<DVec2> {
+    if signed_area(poly) < 0.0 {
+        poly.iter().rev().copied().collect()
+    } else {
+        poly.to_vec()
+    }
+}
+
 /// Area of a polygon (absolute).
 pub fn area(poly: &[DVec2]) -> f64 {
     signed_area(poly).abs()

@@ -161,6 +161,10 @@ pub fn run(job: &Job) -> Result<Outcome> {
         .panels
         .par_iter()
         .map(flatten)
+        .collect::<Vec<_>>()
+        // In panel order, so that the error names the first panel that fails
+        // whatever the thread count.
+        .into_iter()
         .collect::<std::result::Result<_, _>>()
         .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {

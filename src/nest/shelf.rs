@@ -106,13 +106,19 @@ pub fn shelf_layout(
     })
 }
 
-/// The rotation (among `steps` equal steps) with the smallest bounding box that fits
-/// `max_w` × `max_h`, turned to lie flat when that also fits.
 /// The smallest bounding box of an outline among `steps` rotations (width, height).
 pub fn smallest_box(outline: &[DVec2], steps: u32) -> DVec2 {
     orient(outline, steps, f64::INFINITY, f64::INFINITY).map_or(DVec2::ZERO, |o| o.size)
 }
 
+/// True when the outline's bounding box fits `max_w` × `max_h` in one of `steps`
+/// rotations.
+pub fn fits_rotated(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> bool {
+    orient(outline, steps, max_w, max_h).is_some()
+}
+
+/// The rotation (among `steps` equal steps) with the smallest bounding box that fits
+/// `max_w` × `max_h`, turned to lie flat when that also fits.
 fn orient(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> Option<Oriented> {
     let steps = steps.max(1);
     let mut best: Option<(f64, Oriented)> = None;

@@ -186,6 +186,10 @@ pub fn true_shape_layout(
             )
             .ok_or_else(|| too_large(i, outline, sheet, options.rotations))
         })
+        .collect::<Vec<_>>()
+        // In part order, so that the error names the first part too large whatever
+        // the thread count.
+        .into_iter()
         .collect::<Result<_, _>>()?;
 
     let mut nester = Nester {

@@ -28,10 +28,13 @@ use rayon::prelude::*;
 
 use super::{PanelLimit, SchemeError, SchemeOptions, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
-use crate::mesh::geometry::vector_area;
+use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
+use crate::nest::shelf::{fits_rotated, smallest_box};
 use crate::panel::{FacetFrame, Hole, Label, LabelKind, Panel, Source};
-use crate::plane::{clip_convex, contains, convex_hull, distance_to_border, segment_distance};
+use crate::plane::{
+    clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, segment_distance,
+};
 
 /// Fraction of the band side (from the far corner) where a strand's end starts and
 /// ends, for band scale `t`.
@@ -246,10 +249,10 @@ fn landings(
     let o = entry[0];
     let flat = |p: DVec3| DVec2::new((p - o).dot(x), (p - o).dot(y));
     let (entry2, exit2) = (entry.map(flat), exit.map(flat));
-    let own = ccw(&[entry2[0], entry2[1], exit2[1], exit2[0]]);
+    let own = counter_clockwise(&[entry2[0], entry2[1], exit2[1], exit2[0]]);
     let mut reach = [0.0f64; 2];
     for side in 0..2 {
-        let theirs = ccw(&strands.region(neighbours[side]).map(flat));
+        let theirs = counter_clockwise(&strands.region(neighbours[side]).map(flat));
         let overlap = clip_convex(&theirs, &own);
         if crate::plane::area(&overlap) <= 1e-9 {
             continue;
@@ -486,8 +489,7 @@ fn piece_facets(ribbon: &Ribbon, k: usize, flip: bool) -> Vec<Vec<Corner>> {
         }
         loop_
     };
-    let size = pts[0].distance(pts[2]).max(pts[1].distance(pts[3]));
-    if out_of_plane(&pts) <= 1e-9 * size.max(1e-9) {
+    if planarity_error(&pts) <= 1e-9 {
         return vec![orient(quad.to_vec())];
     }
     // Two triangles along the diagonal with the smaller fold.
@@ -504,15 +506,6 @@ fn piece_facets(ribbon: &Ribbon, k: usize, flip: bool) -> Vec<Vec<Corner>> {
     tris.iter()
         .map(|t| orient(t.iter().map(|&i| quad[i]).collect()))
         .collect()
-}
-
-/// Distance of the fourth point from the plane of the first three.
-fn out_of_plane(p: &[DVec3]) -> f64 {
-    let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    if n.length_squared() == 0.0 {
-        return 0.0;
-    }
-    (p[3] - p[0]).dot(n.normalize()).abs()
 }
 
 /// A chain of pieces unrolled into the plane, one piece at a time.
@@ -536,15 +529,7 @@ impl Unrolled {
         let facet = &ribbon.facets[k][0];
         let pts: Vec<DVec3> = facet.iter().map(|&c| ribbon.point(k, c)).collect();
         let normal = vector_area(pts.iter().copied()).normalize_or_zero();
-        let edge = pts[1] - pts[0];
-        let x3 = (edge - edge.dot(normal) * normal).normalize();
-        let frame = FacetFrame {
-            origin3: pts[0],
-            x3,
-            y3: normal.cross(x3),
-            origin2: DVec2::ZERO,
-            x2: DVec2::X,
-        };
+        let frame = FacetFrame::on_hinge(pts[0], pts[1], normal, DVec2::ZERO, DVec2::X);
         let line = ribbon.lines[k % ribbon.lines.len()];
         Self {
             lines: vec![line.map(|p| frame.to_2d(p))],
@@ -574,19 +559,13 @@ impl Unrolled {
                 return false;
             };
             let (c, d) = (facet[i], facet[(i + 1) % m]);
-            let (pa, pb) = (ribbon.point(k, c), ribbon.point(k, d));
-            let (qa, qb) = (
+            let frame = FacetFrame::on_hinge(
+                ribbon.point(k, c),
+                ribbon.point(k, d),
+                normal,
                 placed[c.line as usize][c.end as usize].unwrap_or_default(),
                 placed[d.line as usize][d.end as usize].unwrap_or_default(),
             );
-            let x3 = (pb - pa).normalize();
-            let frame = FacetFrame {
-                origin3: pa,
-                x3,
-                y3: normal.cross(x3),
-                origin2: qa,
-                x2: (qb - qa).normalize(),
-            };
             for (j, &corner) in facet.iter().enumerate() {
                 let slot = &mut placed[corner.line as usize][corner.end as usize];
                 if slot.is_none() {
@@ -599,7 +578,7 @@ impl Unrolled {
                 .collect();
             self.area += crate::plane::area(&poly);
             self.facets.push(FlatFacet {
-                poly: ccw(&poly),
+                poly: counter_clockwise(&poly),
                 piece: first_line,
             });
             self.frames.push(frame);
@@ -647,15 +626,6 @@ fn apart(a: &FlatFacet, b: &FlatFacet) -> bool {
     gap >= CLEARANCE && !contains(p, q[0]) && !contains(q, p[0])
 }
 
-/// The polygon counter-clockwise (clipping wants a convex counter-clockwise clip).
-fn ccw(p: &[DVec2]) -> Vec<DVec2> {
-    if crate::plane::signed_area(p) < 0.0 {
-        p.iter().rev().copied().collect()
-    } else {
-        p.to_vec()
-    }
-}
-
 /// True when the points fit the panel limit in one of its orientations, and their
 /// most compact bounding box (over those orientations) lies along the sheet: a
 /// segment that only fits across the sheet's diagonal would take a sheet of its own.
@@ -663,19 +633,9 @@ fn fits(points: &[DVec2], limit: &PanelLimit) -> bool {
     let hull = convex_hull(points);
     let steps = limit.rotations.max(1);
     let (w, h) = (limit.width - FIT_SLACK, limit.height - FIT_SLACK);
-    let mut any = false;
-    let mut compact = (f64::INFINITY, DVec2::ZERO);
-    for k in 0..steps {
-        let turn = DVec2::from_angle(std::f64::consts::TAU * f64::from(k) / f64::from(steps));
-        let (lo, hi) = crate::nest::bounds(hull.iter().map(|&p| turn.rotate(p)));
-        let size = hi - lo;
-        any |= size.x <= w && size.y <= h;
-        if size.x * size.y < compact.0 {
-            compact = (size.x * size.y, size);
-        }
-    }
-    let size = compact.1;
-    any && ((size.x <= w && size.y <= h) || (size.x <= h && size.y <= w))
+    let compact = smallest_box(&hull, steps);
+    fits_rotated(&hull, steps, w, h)
+        && ((compact.x <= w && compact.y <= h) || (compact.x <= h && compact.y <= w))
 }
 
 /// What a segment must respect besides not overlapping itself.
@@ -722,37 +682,38 @@ fn longest_run(ribbon: &Ribbon, start: usize, most: usize, limits: &Limits) -> u
 }
 
 /// Cuts a ring into segments: `(first corner, corners spanned)` each, fewest segments
-/// over the start positions tried (ties: the earliest start). `None` when one edge
-/// crossing alone does not fit.
-fn plan_segments(ribbon: &Ribbon, limits: &Limits) -> Option<Vec<(usize, usize)>> {
+/// over the start positions tried (ties: the earliest start). `Err(corner)` when the
+/// crossing after that corner alone does not fit.
+fn plan_segments(ribbon: &Ribbon, limits: &Limits) -> Result<Vec<(usize, usize)>, usize> {
     let n = ribbon.edge_count();
-    let greedy = |start: usize| -> Option<Vec<(usize, usize)>> {
+    let greedy = |start: usize| -> Result<Vec<(usize, usize)>, usize> {
         let mut plan = Vec::new();
         let mut done = 0;
         while done < n {
-            let len = longest_run(ribbon, (start + done) % n, n - done, limits);
+            let corner = (start + done) % n;
+            let len = longest_run(ribbon, corner, n - done, limits);
             if len == 0 {
-                return None;
+                return Err(corner);
             }
-            plan.push(((start + done) % n, len));
+            plan.push((corner, len));
             done += len;
         }
-        Some(plan)
+        Ok(plan)
     };
     let first = greedy(0)?;
     if first.len() == 1 {
-        return Some(first);
+        return Ok(first);
     }
     let tries = first[0].1.min(MAX_STARTS);
     let mut best = first;
     for start in 1..=tries {
-        if let Some(plan) = greedy(start % n) {
+        if let Ok(plan) = greedy(start % n) {
             if plan.len() < best.len() {
                 best = plan;
             }
         }
     }
-    Some(best)
+    Ok(best)
 }
 
 /// Builds the woven panels: one per segment of every cycle's ribbon.
@@ -765,14 +726,25 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
     let plans: Vec<Vec<(usize, usize)>> = ribbons
         .par_iter()
         .map(|r| {
-            plan_segments(r, &limits).ok_or_else(|| {
-                let first: Vec<DVec3> = r.lines.iter().take(6).flatten().copied().collect();
+            plan_segments(r, &limits).map_err(|corner| {
+                // The crossing that does not fit: this corner's pieces and the next
+                // corner's face pieces.
+                let ring = r.lines.len();
+                let pieces = r.corner_pieces(corner).len() + face_part(r, corner + 1).len();
+                let start = r.corner_start[corner];
+                let points: Vec<DVec3> = (start..=start + pieces)
+                    .flat_map(|l| r.lines[l % ring])
+                    .collect();
                 SchemeError::TooLarge {
                     cycle: cycle_id(r.cycle),
-                    size: crate::mesh::geometry::diameter(&first),
+                    size: crate::mesh::geometry::diameter(&points),
                 }
             })
         })
+        .collect::<Vec<_>>()
+        // Collected in cycle order first, so that the error names the first cycle
+        // that fails whatever the thread count.
+        .into_iter()
         .collect::<Result<_, _>>()?;
 
     let mut panels = Vec::new();
@@ -1009,7 +981,7 @@ fn joint_holes(
     // The corner's outline: near ends along one side, far ends back along the other.
     let mut outline: Vec<DVec2> = local.lines.iter().map(|l| l[0]).collect();
     outline.extend(local.lines.iter().rev().map(|l| l[1]));
-    let outline = ccw(&outline);
+    let outline = counter_clockwise(&outline);
     let fractions: &[f64] = if wanted == 1 {
         &[0.5]
     } else {
