@@ -72,9 +72,25 @@ fn split_number(s: &str) -> (&str, &str) {
     (&s[..end], &s[end..])
 }
 
+/// The longest length (mm) any option takes: 1 km. Far beyond any sheet or build, and
+/// small enough that areas and offsets of such lengths stay finite in f32 collision
+/// geometry.
+pub const MAX_LENGTH_MM: f64 = 1e6;
+
 /// Parses a length with its unit ("4ft", "1.2m", "48in", "0.25 in", "600mm") into
-/// millimetres. A unit is required: a bare "4" could mean feet or millimetres.
+/// millimetres. A unit is required: a bare "4" could mean feet or millimetres. Lengths
+/// beyond [`MAX_LENGTH_MM`] either way are refused.
 pub fn parse_length(text: &str) -> std::result::Result<f64, String> {
+    let mm = parse_length_unbounded(text)?;
+    if mm.abs() > MAX_LENGTH_MM {
+        return Err(format!(
+            "'{text}' is longer than 1 km, the longest length unfold takes"
+        ));
+    }
+    Ok(mm)
+}
+
+fn parse_length_unbounded(text: &str) -> std::result::Result<f64, String> {
     let (number, unit) = split_number(text);
     let value: f64 = number.parse().map_err(|_| {
         format!(
@@ -146,14 +162,19 @@ pub fn parse_sheet(text: &str) -> std::result::Result<SheetSize, String> {
             } else {
                 w.to_string()
             };
-            let width = parse_length(&w_text).map_err(|_| bad())?;
-            let height = parse_length(h).map_err(|_| bad())?;
+            let width = parse_length_unbounded(&w_text).map_err(|_| bad())?;
+            let height = parse_length_unbounded(h).map_err(|_| bad())?;
             (width, height)
         }
     };
     if width <= 0.0 || height <= 0.0 {
         return Err(format!(
             "sheet '{text}' must have a positive width and height"
+        ));
+    }
+    if width > MAX_LENGTH_MM || height > MAX_LENGTH_MM {
+        return Err(format!(
+            "sheet '{text}' is larger than 1 km, the longest length unfold takes"
         ));
     }
     Ok(SheetSize {
@@ -227,6 +248,11 @@ pub struct ModelOptions {
     /// [default: no simplification]
     #[arg(long, value_name = "N")]
     pub target_faces: Option<usize>,
+
+    /// Remove connected components with fewer than N faces (stray fragments of a scan,
+    /// loose parts too small to build). [default: 0, keep every component]
+    #[arg(long, value_name = "N")]
+    pub min_component: Option<usize>,
 }
 
 /// How model units become millimetres.
@@ -263,6 +289,8 @@ pub struct ModelSettings {
     pub planarity_tol: f64,
     /// Simplification budget, if any.
     pub budget: Option<crate::mesh::simplify::Budget>,
+    /// Components with fewer faces than this are removed (0 keeps all).
+    pub min_component: usize,
 }
 
 impl ModelOptions {
@@ -276,6 +304,7 @@ impl ModelOptions {
             planarity_tol: self.planarity_tol.or(other.planarity_tol),
             target_edges: self.target_edges.or(other.target_edges),
             target_faces: self.target_faces.or(other.target_faces),
+            min_component: self.min_component.or(other.min_component),
         }
     }
 
@@ -320,6 +349,7 @@ impl ModelOptions {
         };
         Ok(ModelSettings {
             budget,
+            min_component: self.min_component.unwrap_or(0),
             scaling: Scaling {
                 size,
                 unit_mm: self.units.unwrap_or(LengthUnit::Mm).mm(),
@@ -428,7 +458,9 @@ pub struct BuildOptions {
     pub label_height: Option<String>,
 
     /// What to do with faces that are not planar within --planarity-tol: triangulate
-    /// (split along the diagonal that folds least) or error. [default: triangulate]
+    /// (split along the diagonal that folds least), planarize (move vertices until every
+    /// face is planar, staying close to the input; the report gives the largest move) or
+    /// error. [default: triangulate]
     #[arg(long, value_name = "POLICY")]
     pub nonplanar: Option<NonPlanar>,
 
@@ -489,6 +521,8 @@ pub enum Connectors {
 pub enum NonPlanar {
     /// Split them into triangles.
     Triangulate,
+    /// Move vertices until every face is planar (guided projection).
+    Planarize,
     /// Refuse the model.
     Error,
 }

@@ -30,6 +30,7 @@ pub use config::{BuildOptions, Job, ModelOptions, ModelSettings};
 pub use error::{Error, InputError, Result};
 pub use run::{report_text, run, Outcome};
 
+use mesh::components::largest_component;
 use mesh::read::Group;
 use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};
 
@@ -46,6 +47,48 @@ pub fn load_model(
             weld: settings.weld,
         },
     )?;
+    if settings.min_component > 1 {
+        let dropped =
+            mesh::components::drop_small_components(&prepared.mesh, settings.min_component)
+                .map_err(|e| {
+                    InputError::new(
+                        path,
+                        error::Location::File,
+                        e.to_string(),
+                        "lower --min-component",
+                    )
+                })?;
+        match dropped {
+            Some((kept, report)) => {
+                let faces: usize = report.sizes.iter().sum();
+                prepared.notes.push(Note {
+                    kind: "small-components",
+                    message: format!(
+                        "removed {} components with fewer than {} faces ({faces} faces; sizes {}); {} components kept",
+                        report.sizes.len(),
+                        settings.min_component,
+                        report.sizes.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", "),
+                        report.kept
+                    ),
+                });
+                prepared.mesh = kept;
+            }
+            None if largest_component(&prepared.mesh) < settings.min_component => {
+                return Err(InputError::new(
+                    path,
+                    error::Location::File,
+                    format!(
+                        "every component has fewer than --min-component {} faces (the largest has {})",
+                        settings.min_component,
+                        largest_component(&prepared.mesh)
+                    ),
+                    "lower --min-component",
+                )
+                .into());
+            }
+            None => {}
+        }
+    }
     if let Some(budget) = settings.budget {
         let (simplified, report) = mesh::simplify::simplify(&prepared.mesh, budget)
             .map_err(|e| InputError::new(path, error::Location::File, e.to_string(), ""))?;

@@ -114,3 +114,57 @@ fn the_thesis_bunny_builds_end_to_end() {
         "simplification is deterministic"
     );
 }
+
+/// `--min-component N` removes the components of fewer than N faces, says which, keeps
+/// the rest untouched, and refuses a model where nothing would be left.
+#[test]
+fn small_components_are_removed() {
+    let Some(shared) = shared_models("min-component") else {
+        return;
+    };
+    // Suzanne: the head (436 faces) and two eyes (32 faces each).
+    let suzanne = shared.join("suzanne.obj");
+    let all = inspect_json(&suzanne, &[]);
+    assert_eq!(count(&all, "mesh.faces"), 500);
+    let kept = inspect_json(&suzanne, &["--min-component", "40"]);
+    assert_eq!(count(&kept, "mesh.faces"), 436, "{kept}");
+    assert_eq!(kept["mesh"]["components"][0]["faces"], 436, "{kept}");
+    assert_eq!(kept["mesh"]["components"].as_array().unwrap().len(), 1);
+    assert_eq!(count(&kept, "mesh.boundary_loops"), 2, "{kept}");
+    let note = kept["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["kind"] == "small-components")
+        .unwrap_or_else(|| panic!("no note: {kept}"));
+    assert!(
+        note["message"]
+            .as_str()
+            .unwrap()
+            .starts_with("removed 2 components with fewer than 40 faces (64 faces; sizes 32, 32)"),
+        "{note}"
+    );
+    // At the threshold nothing goes (components of exactly N faces stay).
+    let same = inspect_json(&suzanne, &["--min-component", "32"]);
+    assert_eq!(count(&same, "mesh.faces"), 500, "{same}");
+
+    // Nothing left: one clear error naming the file, exit 3.
+    let run = common::build::unfold([
+        std::ffi::OsStr::new("inspect"),
+        suzanne.as_os_str(),
+        std::ffi::OsStr::new("--min-component"),
+        std::ffi::OsStr::new("1000"),
+    ]);
+    assert_eq!(run.code, Some(3), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("suzanne.obj")
+            && run.stderr.contains(
+                "every component has fewer than --min-component 1000 faces (the largest has 436)"
+            ),
+        "{}",
+        run.stderr
+    );
+    // A one-component model is untouched.
+    let genus2 = inspect_json(&model("genus2"), &["--min-component", "10"]);
+    assert_eq!(count(&genus2, "mesh.faces"), 50, "{genus2}");
+}

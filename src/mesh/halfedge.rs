@@ -87,6 +87,17 @@ impl Mesh {
         &self.positions
     }
 
+    /// Replaces every position (one per vertex, in vertex order): the connectivity
+    /// stays, only the geometry moves (planarization).
+    pub fn set_positions(&mut self, positions: Vec<DVec3>) {
+        assert_eq!(
+            positions.len(),
+            self.positions.len(),
+            "one position per vertex"
+        );
+        self.positions = positions;
+    }
+
     /// Multiplies every position by `factor` (model units to millimetres, say).
     pub fn scale(&mut self, factor: f64) {
         for p in &mut self.positions {

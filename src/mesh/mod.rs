@@ -5,10 +5,12 @@
 //! graph rotation system are views of it, not separate structures.
 
 pub mod build;
+pub mod components;
 pub mod ergs;
 pub mod geometry;
 pub mod halfedge;
 pub mod ids;
+pub mod planarize;
 pub mod polygons;
 pub mod prepare;
 pub mod read;
@@ -24,7 +26,7 @@ pub use halfedge::Mesh;
 pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
 pub use polygons::Polygons;
 pub use prepare::{prepare, Note, PrepareOptions, PreparedModel};
-pub use read::{read_model, Format, RawModel};
+pub use read::{parse_model, read_model, Format, RawModel};
 pub use soup::SoupFacts;
 pub use topology::{ComponentFacts, GeometryFacts, Topology};
 pub use validate::ConnectivityError;

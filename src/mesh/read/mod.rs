@@ -129,6 +129,12 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
             "check the path and permissions",
         )
     })?;
+    parse_model(path, format, &bytes)
+}
+
+/// Parses a model file's bytes (already read from `path`, which only names the file in
+/// messages). Separate from [`read_model`] so the fuzz targets can feed it bytes.
+pub fn parse_model(path: &Path, format: Format, bytes: &[u8]) -> Result<RawModel, InputError> {
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(InputError::new(
             path,
@@ -138,7 +144,7 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
         ));
     }
     if format != Format::Stl {
-        if let Some(at) = binary_data_at(&bytes) {
+        if let Some(at) = binary_data_at(bytes) {
             let what = if format == Format::Obj { "OBJ" } else { "OFF" };
             return Err(InputError::new(
                 path,
@@ -149,9 +155,9 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
         }
     }
     let model = match format {
-        Format::Obj => obj::parse(path, &bytes)?,
-        Format::Off => off::parse(path, &bytes)?,
-        Format::Stl => stl::parse(path, &bytes)?,
+        Format::Obj => obj::parse(path, bytes)?,
+        Format::Off => off::parse(path, bytes)?,
+        Format::Stl => stl::parse(path, bytes)?,
     };
     if model.polys.face_count() == 0 {
         return Err(InputError::new(
@@ -212,7 +218,17 @@ pub(crate) fn text_lines<'a>(
         })
 }
 
-/// Parses one finite coordinate, naming the token when it fails.
+/// The largest coordinate magnitude read. Squares of larger values overflow f64 in
+/// areas and normals, so every face would be degenerate for a reason no message could
+/// name afterwards; no real model is measured in such numbers.
+pub(crate) const MAX_COORDINATE: f64 = 1e15;
+
+/// Why a coordinate this large is refused, and what to do.
+pub(crate) const TOO_LARGE_FIX: &str =
+    "coordinates must lie within ±1e15: export the model in larger units or remove the stray vertex";
+
+/// Parses one finite coordinate within ±[`MAX_COORDINATE`], naming the token when it
+/// fails.
 pub(crate) fn parse_coordinate(
     path: &Path,
     line: u64,
@@ -220,7 +236,13 @@ pub(crate) fn parse_coordinate(
     what: &str,
 ) -> Result<f64, InputError> {
     match token.parse::<f64>() {
-        Ok(x) if x.is_finite() => Ok(x),
+        Ok(x) if x.is_finite() && x.abs() <= MAX_COORDINATE => Ok(x),
+        Ok(x) if x.is_finite() => Err(InputError::new(
+            path,
+            Location::Line(line),
+            format!("{what} coordinate '{token}' is too large"),
+            TOO_LARGE_FIX,
+        )),
         Ok(_) => Err(InputError::new(
             path,
             Location::Line(line),

@@ -104,6 +104,14 @@ fn read_binary(path: &Path, bytes: &[u8]) -> Result<Soup, InputError> {
                         "replace NaN or infinite coordinates with real positions",
                     ));
                 }
+                if f64::from(value).abs() > super::MAX_COORDINATE {
+                    return Err(InputError::new(
+                        path,
+                        Location::Byte((start + at) as u64),
+                        format!("triangle {t} has a coordinate of {value:e}, too large"),
+                        super::TOO_LARGE_FIX,
+                    ));
+                }
                 *slot = value as f64;
             }
             corners.push(DVec3::from_array(xyz));

@@ -1,0 +1,159 @@
+//! The hot functions of the pipeline, one criterion group per stage: the schemes'
+//! panel building, unrolling with label fitting, nesting (true-shape and shelf) and
+//! drawing a sheet as SVG. On spot at 4 ft when ../shared/models is present, and on the
+//! project's genus-2 model always. Run with `cargo bench --bench stages`.
+
+use std::path::{Path, PathBuf};
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use glam::DVec2;
+
+use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
+use unfold::export::{draw_sheet, svg};
+use unfold::flatten::flatten;
+use unfold::labels::{fit_labels, LabelOptions};
+use unfold::mesh::Mesh;
+use unfold::nest::{lay_out, NestSettings, NesterName, SheetSpec};
+use unfold::panel::FlatPanel;
+use unfold::scheme::build_panels;
+
+fn job(model: &Path, scheme: SchemeName, size: &str) -> Job {
+    BuildOptions {
+        scheme: Some(scheme),
+        model: ModelOptions {
+            size: Some(size.into()),
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+    .resolve(model)
+    .expect("options resolve")
+}
+
+/// The mesh the scheme works on (loaded, prepared, scaled and split).
+fn scheme_mesh(job: &Job) -> Mesh {
+    let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
+    unfold::run::scheme_mesh(job, &raw, prepared.mesh)
+        .expect("scheme mesh")
+        .mesh
+}
+
+fn flat_panels(job: &Job, mesh: &Mesh) -> Vec<FlatPanel> {
+    let output = build_panels(job.scheme, mesh, &job.scheme_options).expect("scheme");
+    output
+        .panels
+        .iter()
+        .map(|p| {
+            let mut flat = flatten(p).expect("unrolls");
+            fit_labels(&mut flat, LabelOptions::default());
+            flat
+        })
+        .collect()
+}
+
+fn models() -> Vec<(String, PathBuf, &'static str)> {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let mut list = vec![(
+        "genus2".to_string(),
+        root.join("models/genus2.obj"),
+        "300mm",
+    )];
+    let spot = root.join("../shared/models/spot.obj");
+    if spot.is_file() {
+        list.push(("spot".to_string(), spot, "4ft"));
+    } else {
+        eprintln!("skipping spot: {} is absent", spot.display());
+    }
+    list
+}
+
+fn schemes_and_flatten(c: &mut Criterion) {
+    let mut scheme_group = c.benchmark_group("scheme");
+    scheme_group.sample_size(10);
+    for (name, path, size) in models() {
+        for scheme in [
+            SchemeName::HalfEdge,
+            SchemeName::QuadEdge,
+            SchemeName::WingedEdge,
+            SchemeName::Woven,
+        ] {
+            let job = job(&path, scheme, size);
+            let mesh = scheme_mesh(&job);
+            scheme_group.bench_function(BenchmarkId::new(scheme.to_string(), &name), |b| {
+                b.iter(|| build_panels(job.scheme, &mesh, &job.scheme_options).unwrap())
+            });
+        }
+    }
+    scheme_group.finish();
+
+    let mut flatten_group = c.benchmark_group("flatten+labels");
+    flatten_group.sample_size(10);
+    for (name, path, size) in models() {
+        for scheme in [SchemeName::HalfEdge, SchemeName::QuadEdge] {
+            let job = job(&path, scheme, size);
+            let mesh = scheme_mesh(&job);
+            let output = build_panels(job.scheme, &mesh, &job.scheme_options).unwrap();
+            flatten_group.bench_function(BenchmarkId::new(scheme.to_string(), &name), |b| {
+                b.iter(|| {
+                    for p in &output.panels {
+                        let mut flat = flatten(p).unwrap();
+                        fit_labels(&mut flat, LabelOptions::default());
+                    }
+                })
+            });
+        }
+    }
+    flatten_group.finish();
+}
+
+fn nesting_and_export(c: &mut Criterion) {
+    let mut group = c.benchmark_group("nest");
+    group.sample_size(10);
+    let mut drawn = Vec::new();
+    for (name, path, size) in models() {
+        let job = job(&path, SchemeName::HalfEdge, size);
+        let flat = flat_panels(&job, &scheme_mesh(&job));
+        // The largest 400 panels: a job of a few sheets, so a sample takes seconds.
+        let mut by_area: Vec<&FlatPanel> = flat.iter().collect();
+        by_area.sort_by(|a, b| b.area.total_cmp(&a.area).then(a.id.cmp(&b.id)));
+        by_area.truncate(400);
+        let outlines: Vec<Vec<DVec2>> = by_area.iter().map(|p| p.outer()).collect();
+        let areas: Vec<f64> = by_area.iter().map(|p| p.area).collect();
+        let sheet = SheetSpec {
+            width: job.sheet.width,
+            height: job.sheet.height,
+            margin: job.margin,
+            spacing: job.spacing,
+        };
+        for nester in [NesterName::Shelf, NesterName::TrueShape] {
+            let settings = NestSettings {
+                nester,
+                search: job.nest.search,
+            };
+            group.bench_function(BenchmarkId::new(nester.as_str(), &name), |b| {
+                b.iter(|| lay_out(&outlines, &areas, sheet, &settings).unwrap())
+            });
+        }
+
+        let layout = lay_out(&outlines, &areas, sheet, &job.nest).unwrap().layout;
+        let owned: Vec<FlatPanel> = by_area.iter().map(|p| (*p).clone()).collect();
+        drawn.push((name, layout, owned, sheet));
+    }
+    group.finish();
+
+    let mut group = c.benchmark_group("svg-first-sheet");
+    for (name, layout, panels, sheet) in &drawn {
+        group.bench_function(name.as_str(), |b| {
+            b.iter(|| {
+                let mut sink =
+                    svg::SvgSheet::new(sheet.width, sheet.height, svg::SvgStyle::default());
+                draw_sheet(layout, 0, panels, &mut sink);
+                sink.finish()
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, schemes_and_flatten, nesting_and_export);
+criterion_main!(benches);

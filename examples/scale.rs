@@ -1,0 +1,82 @@
+//! Load → flatten at scale: reads a model, prepares it, builds the scheme's panels and
+//! unrolls them, printing the time of each stage and the peak memory, without nesting
+//! or writing sheets (a million panels would fill thousands of sheets). For issue 8's
+//! scale figures:
+//!
+//! ```text
+//! cargo run --release --example large_torus -- 1000 1000 target/torus-1M.obj
+//! cargo run --release --example scale -- target/torus-1M.obj half-edge
+//! ```
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use rayon::prelude::*;
+use unfold::config::{BuildOptions, ModelOptions, SchemeName};
+use unfold::flatten::flatten;
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let usage = "usage: scale MODEL [half-edge|quad-edge|winged-edge]";
+    let model = PathBuf::from(args.get(1).expect(usage));
+    let scheme = match args.get(2).map(String::as_str) {
+        None | Some("half-edge") => SchemeName::HalfEdge,
+        Some("quad-edge") => SchemeName::QuadEdge,
+        Some("winged-edge") => SchemeName::WingedEdge,
+        Some(other) => anyhow::bail!("{usage} (not {other})"),
+    };
+    let job = BuildOptions {
+        scheme: Some(scheme),
+        model: ModelOptions {
+            size: Some("4ft".into()),
+            ..Default::default()
+        },
+        ..Default::default()
+    }
+    .resolve(&model)?;
+    let input_bytes = std::fs::metadata(&model)?.len();
+
+    let start = Instant::now();
+    let mut last = start;
+    let mut lap = |stage: &str| {
+        let now = Instant::now();
+        println!(
+            "{stage:<8} {:>8.0} ms   resident {:>6} MiB",
+            (now - last).as_secs_f64() * 1e3,
+            memory_kib("VmRSS:").unwrap_or(0) / 1024
+        );
+        last = now;
+    };
+    let (raw, prepared) = unfold::load_model(&model, &job.model)?;
+    let faces = prepared.mesh.face_count();
+    lap("load");
+    let scheme_mesh = unfold::run::scheme_mesh(&job, &raw, prepared.mesh)?;
+    drop(raw);
+    lap("split");
+    let output = unfold::scheme::build_panels(scheme, &scheme_mesh.mesh, &job.scheme_options)?;
+    lap("scheme");
+    let flat = output
+        .panels
+        .par_iter()
+        .map(flatten)
+        .collect::<Result<Vec<_>, _>>()?;
+    lap("flatten");
+    let total = start.elapsed().as_secs_f64();
+    let peak_kib = memory_kib("VmHWM:").unwrap_or(0);
+    println!(
+        "{faces} faces, {} panels, {} flat; load → flatten {total:.2} s; peak memory {} MiB ({:.1} × the {} MiB input file)",
+        output.panels.len(),
+        flat.len(),
+        peak_kib / 1024,
+        peak_kib as f64 * 1024.0 / input_bytes as f64,
+        input_bytes / (1024 * 1024)
+    );
+    Ok(())
+}
+
+/// A memory figure of this process (`VmRSS:` now, `VmHWM:` peak) on Linux, in KiB.
+fn memory_kib(key: &str) -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with(key))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
