@@ -12,6 +12,7 @@ use std::path::{Path, PathBuf};
 use tempfile::TempDir;
 
 use common::build::{finish, unfold_command, Run};
+use common::corpus::{binary_stl, moebius_obj, random_bytes, CUBE, TWO_TRIANGLES};
 
 // ---------------------------------------------------------------------------------------
 // Helpers
@@ -115,57 +116,8 @@ fn assert_ok_notes(case: &str, run: &Run) -> String {
     run.stdout[at + 1..].to_string()
 }
 
-/// Pseudo-random bytes (xorshift), the same on every run.
-fn random_bytes(len: usize, mut seed: u64) -> Vec<u8> {
-    (0..len)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 24) as u8
-        })
-        .collect()
-}
-
-/// A binary STL record: normal, three corners, attribute count.
-fn stl_triangle(corners: [[f32; 3]; 3]) -> Vec<u8> {
-    let mut record = Vec::with_capacity(50);
-    for x in [0.0f32, 0.0, 1.0] {
-        record.extend_from_slice(&x.to_le_bytes());
-    }
-    for corner in corners {
-        for x in corner {
-            record.extend_from_slice(&x.to_le_bytes());
-        }
-    }
-    record.extend_from_slice(&[0, 0]);
-    record
-}
-
-/// A binary STL: 80-byte header, the announced triangle count, then the records.
-fn binary_stl(header: &[u8], announced: u32, triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
-    let mut bytes = header.to_vec();
-    bytes.resize(80, b' ');
-    bytes.extend_from_slice(&announced.to_le_bytes());
-    for &t in triangles {
-        bytes.extend(stl_triangle(t));
-    }
-    bytes
-}
-
-const TWO_TRIANGLES: [[[f32; 3]; 3]; 2] = [
-    [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
-    [[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
-];
-
 /// Four vertices of a unit square in z = 0 (OBJ lines 1–4).
 const SQUARE: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n";
-
-/// A unit cube: 8 vertices, 6 quads, outward.
-const CUBE: &str = "\
-v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1
-f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8
-";
 
 // ---------------------------------------------------------------------------------------
 // Files that cannot be read at all
@@ -348,35 +300,6 @@ fn obj_non_manifold_edge() {
         Some(6),
         &["non-manifold edge", "vertices 2 and 3", "3 faces"],
     );
-}
-
-/// A Möbius strip of `n` quads: a band whose ends are joined with a half twist.
-fn moebius_obj(n: usize) -> String {
-    let mut s = String::new();
-    for i in 0..n {
-        let a = std::f64::consts::TAU * i as f64 / n as f64;
-        let t = a / 2.0;
-        for side in [-1.0, 1.0] {
-            let r = 2.0 + 0.5 * side * t.cos();
-            s += &format!(
-                "v {} {} {}\n",
-                r * a.cos(),
-                r * a.sin(),
-                0.5 * side * t.sin()
-            );
-        }
-    }
-    for i in 0..n {
-        let (a0, a1) = (2 * i + 1, 2 * i + 2);
-        // The last quad joins the first rung upside down: the half twist.
-        let (b0, b1) = if i + 1 < n {
-            (2 * i + 3, 2 * i + 4)
-        } else {
-            (2, 1)
-        };
-        s += &format!("f {a0} {b0} {b1} {a1}\n");
-    }
-    s
 }
 
 #[test]

@@ -21,6 +21,7 @@
 #![allow(dead_code)]
 
 pub mod build;
+pub mod corpus;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
