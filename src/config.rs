@@ -278,6 +278,56 @@ impl Scaling {
     }
 }
 
+/// The smallest model, longest side when built (mm), worth unfolding: below it every
+/// panel is smaller than the laser's kerf.
+pub const MIN_BUILT_MM: f64 = 0.1;
+
+impl ModelSettings {
+    /// Millimetres per model unit for a model whose longest side is `longest_side`
+    /// model units, refusing a build smaller than [`MIN_BUILT_MM`] or longer than
+    /// [`MAX_LENGTH_MM`]: at such sizes the geometry degenerates or overflows
+    /// downstream, where no message could name the cause. The error names what made
+    /// the size: `--scale` (when not 1) or `--size` as usage errors, otherwise the
+    /// model's own coordinates in `--units` as an input error.
+    pub fn checked_mm_per_unit(&self, model: &Path, longest_side: f64) -> Result<f64> {
+        let scaling = &self.scaling;
+        let mm_per_unit = scaling.mm_per_unit(longest_side);
+        let built_mm = longest_side * mm_per_unit;
+        if built_mm.is_finite() && (MIN_BUILT_MM..=MAX_LENGTH_MM).contains(&built_mm) {
+            return Ok(mm_per_unit);
+        }
+        let bound = if built_mm.is_finite() && built_mm < MIN_BUILT_MM {
+            format!("smaller than {MIN_BUILT_MM} mm")
+        } else {
+            "more than 1 km".to_string()
+        };
+        let built = format!("{} mm across", crate::short_number(built_mm));
+        if scaling.scale != 1.0 {
+            return Err(Error::Usage(format!(
+                "--scale: {} makes {} {built}, {bound}; use a scale nearer 1 or give --size",
+                crate::short_number(scaling.scale),
+                model.display()
+            )));
+        }
+        if let Some(size) = scaling.size {
+            return Err(Error::Usage(format!(
+                "--size: {} mm is {bound}; give a size between 0.1 mm and 1 km",
+                crate::short_number(size)
+            )));
+        }
+        Err(crate::error::InputError::new(
+            model,
+            crate::error::Location::File,
+            format!(
+                "the model is {built} when built (one model unit = {} mm), {bound}",
+                scaling.unit_mm
+            ),
+            "give --size with a unit (like --size 4ft) or the right --units",
+        )
+        .into())
+    }
+}
+
 /// Resolved model options.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ModelSettings {

@@ -30,7 +30,7 @@ pub use config::{BuildOptions, Job, ModelOptions, ModelSettings};
 pub use error::{Error, InputError, Result};
 pub use run::{report_text, run, Outcome};
 
-use mesh::components::largest_component;
+use mesh::components::SmallComponents;
 use mesh::read::Group;
 use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};
 
@@ -48,46 +48,7 @@ pub fn load_model(
         },
     )?;
     if settings.min_component > 1 {
-        let dropped =
-            mesh::components::drop_small_components(&prepared.mesh, settings.min_component)
-                .map_err(|e| {
-                    InputError::new(
-                        path,
-                        error::Location::File,
-                        e.to_string(),
-                        "lower --min-component",
-                    )
-                })?;
-        match dropped {
-            Some((kept, report)) => {
-                let faces: usize = report.sizes.iter().sum();
-                prepared.notes.push(Note {
-                    kind: "small-components",
-                    message: format!(
-                        "removed {} components with fewer than {} faces ({faces} faces; sizes {}); {} components kept",
-                        report.sizes.len(),
-                        settings.min_component,
-                        report.sizes.iter().map(|n| n.to_string()).collect::<Vec<_>>().join(", "),
-                        report.kept
-                    ),
-                });
-                prepared.mesh = kept;
-            }
-            None if largest_component(&prepared.mesh) < settings.min_component => {
-                return Err(InputError::new(
-                    path,
-                    error::Location::File,
-                    format!(
-                        "every component has fewer than --min-component {} faces (the largest has {})",
-                        settings.min_component,
-                        largest_component(&prepared.mesh)
-                    ),
-                    "lower --min-component",
-                )
-                .into());
-            }
-            None => {}
-        }
+        drop_small_components(path, settings.min_component, &mut prepared)?;
     }
     if let Some(budget) = settings.budget {
         let (simplified, report) = mesh::simplify::simplify(&prepared.mesh, budget)
@@ -110,6 +71,47 @@ pub fn load_model(
         prepared.mesh = simplified;
     }
     Ok((raw, prepared))
+}
+
+/// `--min-component`: removes the components of fewer than `min_faces` faces, with a
+/// note; refuses a model where nothing would be left.
+fn drop_small_components(
+    path: &Path,
+    min_faces: usize,
+    prepared: &mut PreparedModel,
+) -> Result<()> {
+    let refuse = |problem: String| {
+        InputError::new(
+            path,
+            error::Location::File,
+            problem,
+            "lower --min-component",
+        )
+    };
+    match mesh::components::drop_small_components(&prepared.mesh, min_faces)
+        .map_err(|e| refuse(e.to_string()))?
+    {
+        SmallComponents::NoneSmall => Ok(()),
+        SmallComponents::AllSmall { largest } => Err(refuse(format!(
+            "every component has fewer than --min-component {min_faces} faces (the largest has {largest})"
+        ))
+        .into()),
+        SmallComponents::Dropped(kept, report) => {
+            let faces: usize = report.sizes.iter().sum();
+            let sizes: Vec<String> = report.sizes.iter().map(|n| n.to_string()).collect();
+            prepared.notes.push(Note {
+                kind: "small-components",
+                message: format!(
+                    "removed {} components with fewer than {min_faces} faces ({faces} faces; sizes {}); {} components kept",
+                    report.sizes.len(),
+                    sizes.join(", "),
+                    report.kept
+                ),
+            });
+            prepared.mesh = *kept;
+            Ok(())
+        }
+    }
 }
 
 /// The physical size a model will be built at.
@@ -164,7 +166,7 @@ pub fn inspect(path: &Path, settings: &ModelSettings) -> Result<Inspection> {
     let (raw, prepared) = load_model(path, settings)?;
     let mesh = &prepared.mesh;
     let geometry = mesh.geometry_facts(settings.planarity_tol);
-    let mm = settings.scaling.mm_per_unit(geometry.longest_side());
+    let mm = settings.checked_mm_per_unit(path, geometry.longest_side())?;
     let size_mm = [0, 1, 2].map(|k| (geometry.bbox_max[k] - geometry.bbox_min[k]) * mm);
     let mut notes = prepared.notes.clone();
     if geometry.non_planar_faces > 0 {
@@ -334,6 +336,16 @@ impl Inspection {
             }
         }
         s
+    }
+}
+
+/// A number for a message: [`fmt_num`] when moderate, exponent form when huge or tiny
+/// (f64's `{}` would print 1e300 with 301 digits).
+pub(crate) fn short_number(x: f64) -> String {
+    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
+        format!("{x:.3e}")
+    } else {
+        fmt_num(x)
     }
 }
 

@@ -87,8 +87,9 @@ pub fn scheme_mesh(
     mut mesh: crate::mesh::Mesh,
 ) -> Result<SchemeMesh> {
     let geometry = mesh.geometry_facts(job.model.planarity_tol);
-    let mm_per_unit = job.model.scaling.mm_per_unit(geometry.longest_side());
-    check_built_size(job, geometry.longest_side() * mm_per_unit)?;
+    let mm_per_unit = job
+        .model
+        .checked_mm_per_unit(&job.model_path, geometry.longest_side())?;
     mesh.scale(mm_per_unit);
     let planarized = if job.nonplanar == NonPlanar::Planarize {
         let options = PlanarizeOptions {
@@ -134,62 +135,6 @@ pub fn scheme_mesh(
         mm_per_unit,
         planarized,
     })
-}
-
-/// The smallest model, longest side when built (mm), worth unfolding: below it every
-/// panel is smaller than the laser's kerf.
-const MIN_BUILT_MM: f64 = 0.1;
-
-/// Refuses a model that would be built smaller than [`MIN_BUILT_MM`] or longer than
-/// [`crate::config::MAX_LENGTH_MM`]: at such sizes the geometry degenerates or
-/// overflows downstream, where the message could no longer name the cause. `--scale`
-/// is the only option that can do this (`--size` is bounded when parsed), so a
-/// scale other than 1 makes it a usage error; otherwise the model's own coordinates
-/// (in `--units`) are at fault.
-fn check_built_size(job: &Job, built_mm: f64) -> Result<()> {
-    if built_mm.is_finite() && (MIN_BUILT_MM..=crate::config::MAX_LENGTH_MM).contains(&built_mm) {
-        return Ok(());
-    }
-    let bound = if built_mm.is_finite() && built_mm < MIN_BUILT_MM {
-        format!("smaller than {MIN_BUILT_MM} mm")
-    } else {
-        "more than 1 km".to_string()
-    };
-    let built = format!("{} mm across", short_number(built_mm));
-    let scaling = &job.model.scaling;
-    let model = job.model_path.display();
-    if scaling.scale != 1.0 {
-        return Err(Error::Usage(format!(
-            "--scale: {} makes {model} {built}, {bound}; use a scale nearer 1 or give --size",
-            short_number(scaling.scale),
-        )));
-    }
-    if let Some(size) = scaling.size {
-        return Err(Error::Usage(format!(
-            "--size: {} mm is {bound}; give a size between 0.1 mm and 1 km",
-            short_number(size)
-        )));
-    }
-    Err(InputError::new(
-        &job.model_path,
-        crate::error::Location::File,
-        format!(
-            "the model is {built} when built (one model unit = {} mm), {bound}",
-            scaling.unit_mm
-        ),
-        "give --size with a unit (like --size 4ft) or the right --units",
-    )
-    .into())
-}
-
-/// A number for a message: plain when moderate, in exponent form when huge or tiny
-/// (f64's `{}` would print 1e300 with 301 digits).
-fn short_number(x: f64) -> String {
-    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
-        format!("{x:.3e}")
-    } else {
-        format!("{}", (x * 1e4).round() / 1e4)
-    }
 }
 
 /// Runs a job and writes its output folder (atomically: on any error the folder is

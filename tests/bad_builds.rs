@@ -29,7 +29,9 @@ use std::time::{Duration, Instant};
 use tempfile::TempDir;
 
 use common::build::{unfold_command, Run};
-use common::corpus::{binary_stl, moebius_obj, random_bytes, CUBE, TWO_TRIANGLES};
+use common::corpus::{
+    assert_clean_error, binary_stl, head, moebius_obj, random_bytes, CUBE, TWO_TRIANGLES,
+};
 
 // ---------------------------------------------------------------------------------------
 // Running the binary
@@ -202,49 +204,6 @@ fn assert_untouched(case: &str, sandbox: &Sandbox, before: &BTreeSet<String>) {
 // ---------------------------------------------------------------------------------------
 // What a refused run prints
 // ---------------------------------------------------------------------------------------
-
-/// The first lines of a long stderr (a panic's backtrace), for failure messages.
-fn head(text: &str) -> String {
-    text.lines().take(12).collect::<Vec<_>>().join("\n")
-}
-
-/// No panic, exit `code`, nothing on stdout, one line `unfold: error: …` on stderr
-/// containing every fragment of `says`.
-fn assert_clean_error(case: &str, run: &Run, code: i32, says: &[&str]) {
-    let err = &run.stderr;
-    assert!(
-        !err.contains("panicked") && !run.stdout.contains("panicked"),
-        "{case}: panic (exit {:?}):\n{}",
-        run.code,
-        head(err)
-    );
-    assert_eq!(
-        run.code,
-        Some(code),
-        "{case}: exit code; stderr:\n{}",
-        head(err)
-    );
-    assert!(run.stdout.is_empty(), "{case}: stdout: {}", run.stdout);
-    assert_eq!(
-        err.lines().count(),
-        1,
-        "{case}: stderr is not one line: {err:?}"
-    );
-    assert!(
-        err.ends_with('\n'),
-        "{case}: stderr does not end the line: {err:?}"
-    );
-    assert!(
-        err.starts_with("unfold: error: "),
-        "{case}: prefix: {err:?}"
-    );
-    for fragment in says {
-        assert!(
-            err.contains(fragment),
-            "{case}: does not say {fragment:?}: {err}"
-        );
-    }
-}
 
 /// Where a model error must point.
 #[derive(Clone)]

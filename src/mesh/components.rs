@@ -2,7 +2,7 @@
 //! fragments, and a loose part of a few faces is not worth cutting.
 
 use super::build::{build_mesh, BuildError};
-use super::{FaceId, Mesh, Polygons};
+use super::{Mesh, Polygons};
 
 /// What [`drop_small_components`] removed.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -13,18 +13,32 @@ pub struct DroppedComponents {
     pub kept: usize,
 }
 
-/// The mesh without its components of fewer than `min_faces` faces, or `None` when
-/// nothing is removed. Vertices and faces keep their sources (file numbering), so
-/// later messages still point at the user's lines. `Ok(None)` also when every
-/// component is small: the caller decides how to say so.
-pub fn drop_small_components(
-    mesh: &Mesh,
-    min_faces: usize,
-) -> Result<Option<(Mesh, DroppedComponents)>, BuildError> {
+/// What `--min-component` does to a mesh.
+#[derive(Clone, Debug)]
+pub enum SmallComponents {
+    /// Every component is large enough: the mesh stays as it is.
+    NoneSmall,
+    /// The mesh without the small components.
+    Dropped(Box<Mesh>, DroppedComponents),
+    /// Every component is small: nothing would be left.
+    AllSmall {
+        /// Faces of the largest component.
+        largest: usize,
+    },
+}
+
+/// Removes the components of fewer than `min_faces` faces. Vertices and faces keep
+/// their sources (file numbering), so later messages still point at the user's lines.
+pub fn drop_small_components(mesh: &Mesh, min_faces: usize) -> Result<SmallComponents, BuildError> {
     let (component_of_face, size) = component_sizes(mesh);
     let keep: Vec<bool> = size.iter().map(|&n| n >= min_faces).collect();
-    if keep.iter().all(|&k| k) || !keep.iter().any(|&k| k) {
-        return Ok(None);
+    if keep.iter().all(|&k| k) {
+        return Ok(SmallComponents::NoneSmall);
+    }
+    if !keep.iter().any(|&k| k) {
+        return Ok(SmallComponents::AllSmall {
+            largest: size.into_iter().max().unwrap_or(0),
+        });
     }
     let mut new_index = vec![u32::MAX; mesh.vertex_count()];
     let mut polys = Polygons::new();
@@ -46,7 +60,7 @@ pub fn drop_small_components(
             })
             .collect();
         polys.push_face(&corners);
-        face_source.push(mesh.face_source(FaceId(f.0)));
+        face_source.push(mesh.face_source(f));
     }
     let (kept_mesh, _) = build_mesh(&polys, Some(&vertex_source), Some(&face_source))?;
     let mut sizes: Vec<usize> = size
@@ -56,13 +70,13 @@ pub fn drop_small_components(
         .map(|(&n, _)| n)
         .collect();
     sizes.sort_unstable_by(|a, b| b.cmp(a));
-    Ok(Some((
-        kept_mesh,
+    Ok(SmallComponents::Dropped(
+        Box::new(kept_mesh),
         DroppedComponents {
             sizes,
             kept: keep.iter().filter(|&&k| k).count(),
         },
-    )))
+    ))
 }
 
 /// The component of every face and the face count of every component.
@@ -73,9 +87,4 @@ fn component_sizes(mesh: &Mesh) -> (Vec<u32>, Vec<usize>) {
         size[c as usize] += 1;
     }
     (component_of_face, size)
-}
-
-/// Faces of the largest connected component (0 for an empty mesh).
-pub fn largest_component(mesh: &Mesh) -> usize {
-    component_sizes(mesh).1.into_iter().max().unwrap_or(0)
 }

@@ -52,8 +52,9 @@ pub struct PlanarizeReport {
     pub non_planar_before: usize,
     /// Of them, faces over the tolerance after.
     pub non_planar_after: usize,
-    /// Largest planarity error before and after.
+    /// Largest planarity error before.
     pub max_error_before: f64,
+    /// Largest planarity error after (the input's when nothing moved).
     pub max_error_after: f64,
     /// Largest distance a vertex moved (mesh units).
     pub max_displacement: f64,
@@ -90,15 +91,17 @@ pub fn planarize(
     options: &PlanarizeOptions,
 ) -> Result<PlanarizeReport, PlanarizeError> {
     let polygons: Vec<FaceId> = mesh.faces().filter(|&f| mesh.face_degree(f) > 3).collect();
+    // Corner lists of the constrained faces, by vertex index.
+    let corners: Vec<Vec<u32>> = polygons
+        .iter()
+        .map(|&f| mesh.face_vertices(f).map(|v| v.index() as u32).collect())
+        .collect();
     let errors_of = |positions: &[DVec3]| -> Vec<f64> {
-        polygons
+        corners
             .iter()
-            .map(|&f| {
-                let corners: Vec<DVec3> = mesh
-                    .face_vertices(f)
-                    .map(|v| positions[v.index()])
-                    .collect();
-                planarity_error(&corners)
+            .map(|face| {
+                let points: Vec<DVec3> = face.iter().map(|&v| positions[v as usize]).collect();
+                planarity_error(&points)
             })
             .collect()
     };
@@ -129,10 +132,6 @@ pub fn planarize(
                 .map(|n| n.index() as u32)
                 .collect()
         })
-        .collect();
-    let corners: Vec<Vec<u32>> = polygons
-        .iter()
-        .map(|&f| mesh.face_vertices(f).map(|v| v.index() as u32).collect())
         .collect();
 
     let vertex_vars = 3 * positions.len();

@@ -1,5 +1,8 @@
 //! Generators shared by the broken-input corpora (`tests/bad_inputs.rs` through
-//! `unfold inspect`, `tests/bad_builds.rs` through the main command).
+//! `unfold inspect`, `tests/bad_builds.rs` through the main command) and the check of
+//! what a refused run prints.
+
+use super::build::Run;
 
 /// A unit cube: 8 vertices, 6 quads, outward.
 pub const CUBE: &str = "\
@@ -67,4 +70,47 @@ pub fn moebius_obj(n: usize) -> String {
         s += &format!("f {a0} {b0} {b1} {a1}\n");
     }
     s
+}
+
+/// The first lines of a long stderr (a panic's backtrace), for failure messages.
+pub fn head(text: &str) -> String {
+    text.lines().take(12).collect::<Vec<_>>().join("\n")
+}
+
+/// No panic, exit `code`, nothing on stdout, one line `unfold: error: …` on stderr
+/// containing every fragment of `says`.
+pub fn assert_clean_error(case: &str, run: &Run, code: i32, says: &[&str]) {
+    let err = &run.stderr;
+    assert!(
+        !err.contains("panicked") && !run.stdout.contains("panicked"),
+        "{case}: panic (exit {:?}):\n{}",
+        run.code,
+        head(err)
+    );
+    assert_eq!(
+        run.code,
+        Some(code),
+        "{case}: exit code; stderr:\n{}",
+        head(err)
+    );
+    assert!(run.stdout.is_empty(), "{case}: stdout: {}", run.stdout);
+    assert_eq!(
+        err.lines().count(),
+        1,
+        "{case}: stderr is not one line: {err:?}"
+    );
+    assert!(
+        err.ends_with('\n'),
+        "{case}: stderr does not end the line: {err:?}"
+    );
+    assert!(
+        err.starts_with("unfold: error: "),
+        "{case}: prefix: {err:?}"
+    );
+    for fragment in says {
+        assert!(
+            err.contains(fragment),
+            "{case}: does not say {fragment:?}: {err}"
+        );
+    }
 }
