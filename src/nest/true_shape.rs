@@ -7,7 +7,10 @@
 //!    then slid, bottom-left position is free (first-fit decreasing on true shapes);
 //! 2. improvement: the emptiest sheet is emptied into the others, part by part, with a
 //!    wider search; a sheet left empty is dropped. Partial moves are kept: they only
-//!    make the emptiest sheet emptier (the second objective).
+//!    make the emptiest sheet emptier (the second objective);
+//! 3. elimination by overlap minimisation ([`separate`]): the emptiest sheet's parts
+//!    are put where they overlap least on the others, which are then separated by a
+//!    guided local search; all or nothing per sheet taken away.
 //!
 //! Every random choice comes from one generator seeded by `seed`, and the effort is a
 //! number of samples and rounds, so the result depends on the input and the options
@@ -24,10 +27,12 @@ use jagua_rs::entities::{Container, Item, Layout as JLayout, PItemKey};
 use jagua_rs::geometry::fail_fast::SPSurrogateConfig;
 use jagua_rs::geometry::geo_enums::RotationRange;
 use jagua_rs::geometry::geo_traits::TransformableFrom;
-use jagua_rs::geometry::primitives::{Point, Rect, SPolygon};
+use jagua_rs::geometry::primitives::{Circle, Point, Rect, SPolygon};
 use jagua_rs::geometry::shape_modification::{ShapeModifyConfig, ShapeModifyMode};
 use jagua_rs::geometry::{AllowedOrientations, DTransformation, OriginalShape};
 use rayon::prelude::*;
+
+mod separate;
 
 use super::grid::Grid;
 use super::rng::SplitMix64;
@@ -63,6 +68,12 @@ const EDGE_GAP: f32 = 0.01;
 
 const CLOSE_AFTER_FAILURES: u32 = 40;
 
+/// Failed attempts in a row after which no more sheets are taken away.
+const ELIMINATION_TRIES: u32 = 2;
+
+/// Separation rounds per sheet, per unit of effort.
+const SEPARATION_ROUNDS: usize = 100;
+
 /// Cells of the occupancy grid along the longer side of a sheet.
 const GRID_CELLS: usize = 200;
 
@@ -75,6 +86,8 @@ struct Part {
     area: f64,
     /// Allowed orientations with the collision shape's bounds at each (no translation).
     orientations: Vec<Orientation>,
+    /// Discs inside the collision shape that measure its overlap with others.
+    discs: Vec<Circle>,
 }
 
 #[derive(Clone, Copy)]
@@ -109,7 +122,7 @@ struct Sheet {
     /// Cells covered by the placed parts.
     grid: Grid,
     /// (part, key in the layout, pose).
-    parts: Vec<(usize, PItemKey, DTransformation)>,
+    parts: Vec<(usize, PItemKey, Candidate)>,
     area: f64,
     failures: u32,
 }
@@ -129,6 +142,13 @@ struct Nester<'a> {
     checks: u64,
     /// Area of the largest part.
     largest_area: f64,
+    /// Buffers of the overlap measure.
+    overlap: separate::OverlapScratch,
+    /// Collision checks the current phase may reach.
+    budget: u64,
+    /// When the improvement started, and how long it may run.
+    started: Instant,
+    time_limit: Duration,
 }
 
 /// Lays out parts (outer outlines in mm) by their true shapes.
@@ -137,6 +157,60 @@ pub fn true_shape_layout(
     sheet: SheetSpec,
     options: &NestOptions,
 ) -> Result<Layout, TooLarge> {
+    let (parts, container) = prepare(outlines, sheet, options)?;
+    let mut nester = Nester::new(&parts, container, options);
+
+    // Largest first; ties by index so the order is total.
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
+    for &p in &order {
+        if !nester.place_anywhere(p) {
+            return Err(too_large(p, &outlines[p], sheet, options.rotations));
+        }
+    }
+
+    // The improvement may spend effort/2 times the collision checks of the
+    // construction: bounded work, whatever the machine.
+    nester.started = Instant::now();
+    nester.budget = nester.checks + nester.checks * u64::from(options.effort.max(1)) / 2;
+    let effort = options.effort.max(1) as usize;
+    let mut stalled = 0;
+    for _ in 0..40 * effort {
+        if nester.sheets.len() < 2 || nester.out_of_budget() {
+            break;
+        }
+        // Move what fits out of the emptiest sheet; when nothing does, make room for
+        // its largest part on another sheet by ejecting the parts in one window there.
+        if nester.empty_emptiest_sheet() || nester.eject_and_insert() {
+            stalled = 0;
+        } else {
+            stalled += 1;
+            if stalled >= 4 * effort {
+                break;
+            }
+        }
+    }
+    // Then take whole sheets away by overlap minimisation with what budget is left,
+    // until two attempts in a row fail.
+    let mut failed = 0;
+    while nester.sheets.len() >= 2 && !nester.out_of_budget() && failed < ELIMINATION_TRIES {
+        if nester.eliminate_emptiest(SEPARATION_ROUNDS * effort) {
+            failed = 0;
+        } else {
+            failed += 1;
+        }
+    }
+
+    Ok(nester.finish(outlines.len(), sheet))
+}
+
+/// The collision container of a sheet and the collision items of the parts, or the
+/// first part (in part order, whatever the thread count) too large for the sheet.
+fn prepare(
+    outlines: &[Vec<DVec2>],
+    sheet: SheetSpec,
+    options: &NestOptions,
+) -> Result<(Vec<Part>, Container), TooLarge> {
     let cde_config = CDEConfig {
         quadtree_depth: 6,
         cd_threshold: 16,
@@ -171,8 +245,7 @@ pub fn true_shape_layout(
         Container::new(shape, vec![], cde_config).expect("a rectangle is a valid container")
     };
     let bounds_rect = container.outer_cd().bbox();
-
-    let parts: Vec<Part> = outlines
+    let parts = outlines
         .par_iter()
         .enumerate()
         .map(|(i, outline)| {
@@ -187,66 +260,9 @@ pub fn true_shape_layout(
             .ok_or_else(|| too_large(i, outline, sheet, options.rotations))
         })
         .collect::<Vec<_>>()
-        // In part order, so that the error names the first part too large whatever
-        // the thread count.
         .into_iter()
         .collect::<Result<_, _>>()?;
-
-    let mut nester = Nester {
-        parts: &parts,
-        container,
-        bounds: bounds_rect,
-        rng: SplitMix64::new(options.seed),
-        samples: 24 * options.effort.max(1) as usize,
-        scratch: parts.first().map_or_else(
-            || SPolygon::from(bounds_rect),
-            |p| p.item.shape_cd().as_ref().clone(),
-        ),
-        scratch_part: 0,
-        sheets: Vec::new(),
-        checks: 0,
-        largest_area: parts.iter().map(|p| p.area).fold(0.0, f64::max),
-    };
-
-    // Largest first; ties by index so the order is total.
-    let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
-    for &p in &order {
-        if !nester.place_anywhere(p) {
-            return Err(too_large(p, &outlines[p], sheet, options.rotations));
-        }
-    }
-
-    let started = Instant::now();
-    let rounds = 40 * options.effort.max(1) as usize;
-    // The improvement may spend effort/2 times the collision checks of the
-    // construction: bounded work, whatever the machine.
-    let budget = nester.checks + nester.checks * u64::from(options.effort.max(1)) / 2;
-    let mut stalled = 0;
-    for _ in 0..rounds {
-        if options
-            .time_limit
-            .is_some_and(|limit| started.elapsed() >= limit)
-            || nester.checks >= budget
-        {
-            break;
-        }
-        if nester.sheets.len() < 2 {
-            break;
-        }
-        // Move what fits out of the emptiest sheet; when nothing does, make room for
-        // its largest part on another sheet by ejecting the parts in one window there.
-        if nester.empty_emptiest_sheet() || nester.eject_and_insert() {
-            stalled = 0;
-        } else {
-            stalled += 1;
-            if stalled >= 4 * options.effort.max(1) {
-                break;
-            }
-        }
-    }
-
-    Ok(nester.finish(outlines.len(), sheet))
+    Ok((parts, container))
 }
 
 /// The collision item of a part, or `None` when no allowed orientation fits the sheet.
@@ -308,6 +324,7 @@ fn prepare_part(
         return None;
     }
     Some(Part {
+        discs: separate::overlap_discs(item.shape_cd()),
         item,
         center,
         area: crate::plane::area(outline),
@@ -376,7 +393,44 @@ fn too_large(part: usize, outline: &[DVec2], sheet: SheetSpec, rotations: u32) -
     }
 }
 
-impl Nester<'_> {
+impl<'a> Nester<'a> {
+    /// A search with no sheet open yet.
+    fn new(parts: &'a [Part], container: Container, options: &NestOptions) -> Self {
+        let bounds = container.outer_cd().bbox();
+        Nester {
+            parts,
+            container,
+            bounds,
+            rng: SplitMix64::new(options.seed),
+            samples: 24 * options.effort.max(1) as usize,
+            scratch: parts.first().map_or_else(
+                || SPolygon::from(bounds),
+                |p| p.item.shape_cd().as_ref().clone(),
+            ),
+            scratch_part: 0,
+            sheets: Vec::new(),
+            checks: 0,
+            largest_area: parts.iter().map(|p| p.area).fold(0.0, f64::max),
+            overlap: separate::OverlapScratch::default(),
+            budget: u64::MAX,
+            started: Instant::now(),
+            time_limit: options.time_limit.unwrap_or(Duration::MAX),
+        }
+    }
+
+    /// Opens an empty sheet.
+    fn open_sheet(&mut self) -> usize {
+        let b = self.bounds;
+        self.sheets.push(Sheet {
+            layout: JLayout::new(self.container.clone()),
+            grid: Grid::new(b.x_min, b.y_min, b.x_max, b.y_max, GRID_CELLS),
+            parts: Vec::new(),
+            area: 0.0,
+            failures: 0,
+        });
+        self.sheets.len() - 1
+    }
+
     /// Places a part in the first open sheet with room, or on a new sheet. `false`
     /// only when it does not fit an empty sheet.
     fn place_anywhere(&mut self, part: usize) -> bool {
@@ -391,15 +445,7 @@ impl Nester<'_> {
             }
             self.sheets[s].failures += 1;
         }
-        let b = self.bounds;
-        self.sheets.push(Sheet {
-            layout: JLayout::new(self.container.clone()),
-            grid: Grid::new(b.x_min, b.y_min, b.x_max, b.y_max, GRID_CELLS),
-            parts: Vec::new(),
-            area: 0.0,
-            failures: 0,
-        });
-        let s = self.sheets.len() - 1;
+        let s = self.open_sheet();
         match self.search(s, part, self.samples.max(64)) {
             Some(pose) => {
                 self.put(s, part, pose);
@@ -419,10 +465,11 @@ impl Nester<'_> {
         (self.samples as f64 * (1.0 + 3.0 * ratio)) as usize
     }
 
-    fn put(&mut self, s: usize, part: usize, pose: DTransformation) {
+    fn put(&mut self, s: usize, part: usize, c: Candidate) {
+        let pose = self.pose(part, c);
         let sheet = &mut self.sheets[s];
         let key = sheet.layout.place_item(&self.parts[part].item, pose);
-        sheet.parts.push((part, key, pose));
+        sheet.parts.push((part, key, c));
         sheet.area += self.parts[part].area;
         fill_grid(&mut sheet.grid, &sheet.layout, key);
     }
@@ -439,6 +486,15 @@ impl Nester<'_> {
             .expect("at least one sheet")
     }
 
+    /// Marks the grid of sheet `s` again from its parts.
+    fn refill_grid(&mut self, s: usize) {
+        let sheet = &mut self.sheets[s];
+        sheet.grid.clear();
+        for &(_, key, _) in &sheet.parts {
+            fill_grid(&mut sheet.grid, &sheet.layout, key);
+        }
+    }
+
     /// Takes parts (by slot) off sheet `s`, returning their part indices.
     fn take_off(&mut self, s: usize, mut slots: Vec<usize>) -> Vec<usize> {
         slots.sort_unstable();
@@ -451,10 +507,7 @@ impl Nester<'_> {
             sheet.area -= parts[part].area;
             taken.push(part);
         }
-        sheet.grid.clear();
-        for &(_, key, _) in &sheet.parts {
-            fill_grid(&mut sheet.grid, &sheet.layout, key);
-        }
+        self.refill_grid(s);
         taken
     }
 
@@ -571,7 +624,7 @@ impl Nester<'_> {
 
     /// The best free pose of `part` on sheet `s`: `samples` random positions drawn
     /// from free cells, the best few refined by a local search.
-    fn search(&mut self, s: usize, part: usize, samples: usize) -> Option<DTransformation> {
+    fn search(&mut self, s: usize, part: usize, samples: usize) -> Option<Candidate> {
         let parts = self.parts;
         let p = &parts[part];
         if p.item.shape_cd().area() > 1.05 * self.sheets[s].grid.free_area() {
@@ -615,7 +668,7 @@ impl Nester<'_> {
                 best = Some((score, c));
             }
         }
-        best.map(|(_, c)| self.pose(part, c))
+        best.map(|(_, c)| c)
     }
 
     /// A candidate in orientation `o` with its bounds moved inside the sheet.
@@ -718,7 +771,8 @@ impl Nester<'_> {
     fn finish(self, n: usize, sheet: SheetSpec) -> Layout {
         let mut placements = vec![Placement::default(); n];
         for (s, on_sheet) in self.sheets.iter().enumerate() {
-            for &(part, _, pose) in &on_sheet.parts {
+            for &(part, _, c) in &on_sheet.parts {
+                let pose = self.pose(part, c);
                 let (tx, ty) = pose.translation();
                 let mut placement = Placement {
                     part,
