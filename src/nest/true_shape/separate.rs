@@ -479,8 +479,16 @@ impl Nester<'_> {
                 best = Some((cost, c));
             }
         }
-        let (cost, c) = best.expect("at least one pose was sampled");
-        self.descend(s, part, cost, c, weights)
+        match best {
+            Some((cost, c)) => self.descend(s, part, cost, c, weights),
+            // Only when every sampled cost was infinite: any pose inside the sheet.
+            None => self.clamp(
+                part,
+                0,
+                0.5 * (b.x_min + b.x_max),
+                0.5 * (b.y_min + b.y_max),
+            ),
+        }
     }
 
     /// Greedy descent of the weighted overlap: moves in four directions and turns by
