@@ -38,6 +38,18 @@ impl SheetSpec {
     }
 }
 
+/// A `w` × `h` rectangle with a corner at the origin (counter-clockwise), for the
+/// nesters' tests.
+#[cfg(test)]
+pub(crate) fn test_rectangle(w: f64, h: f64) -> Vec<DVec2> {
+    vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(w, 0.0),
+        DVec2::new(w, h),
+        DVec2::new(0.0, h),
+    ]
+}
+
 /// Where one part goes: rotate about the part's origin, then translate.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Placement {

@@ -141,16 +141,8 @@ fn orient(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> Option<Orien
 
 #[cfg(test)]
 mod tests {
+    use super::super::test_rectangle as rect;
     use super::*;
-
-    fn rect(w: f64, h: f64) -> Vec<DVec2> {
-        vec![
-            DVec2::new(0.0, 0.0),
-            DVec2::new(w, 0.0),
-            DVec2::new(w, h),
-            DVec2::new(0.0, h),
-        ]
-    }
 
     #[test]
     fn boxes_stay_inside_margins_and_apart() {

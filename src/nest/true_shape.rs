@@ -61,11 +61,11 @@ const SAFETY: f64 = 0.02;
 /// Weight of the x coordinate in the bottom-left score (y counts 1).
 const LEFT_WEIGHT: f32 = 0.2;
 
-/// Consecutive parts that may fail on a sheet before the constructive phase stops
-/// trying it.
 /// How far (mm) inside the sheet's bounds a clamped candidate stays.
 const EDGE_GAP: f32 = 0.01;
 
+/// Consecutive parts that may fail on a sheet before the constructive phase stops
+/// trying it.
 const CLOSE_AFTER_FAILURES: u32 = 40;
 
 /// Failed attempts in a row after which no more sheets are taken away.

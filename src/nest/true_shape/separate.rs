@@ -2,8 +2,9 @@
 //! away, its parts first go where they overlap least on the other sheets; then, sheet
 //! by sheet, every overlapping part is moved to its pose of least weighted overlap,
 //! and the weight of every pair still overlapping grows (a guided local search), until
-//! nothing overlaps or the rounds run out. Moves stay on their sheet, so the sheets are
-//! separated one after the other with the one seeded generator.
+//! nothing overlaps or the rounds run out. The sheets are separated one after the
+//! other with the one seeded generator; a part moves off its sheet only when the last
+//! few overlapping parts find a free place on another one.
 //!
 //! Overlap between two parts is measured on discs inside their collision shapes (the
 //! engine's poles and a lattice of inscribed discs): the sum over disc pairs of the
@@ -168,10 +169,11 @@ fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle
 }
 
 impl Nester<'_> {
-    /// Takes the emptiest sheet away: each of its parts, largest first, goes to a
-    /// free pose on one of the three emptiest other sheets, or else to its pose of
-    /// least overlap on the emptiest; the sheets given overlaps are then separated.
-    /// All or nothing: `false` leaves the sheets as they were.
+    /// Takes the emptiest sheet away: each of its parts, largest first, goes to its
+    /// pose of least overlap on whichever of the three emptiest other sheets (by the
+    /// area of their collision shapes) overlaps least, a free pose ending the search;
+    /// the sheets given overlaps are then separated. All or nothing: `false` leaves
+    /// the sheets as they were.
     pub(super) fn eliminate_emptiest(&mut self, rounds: usize) -> bool {
         if self.sheets.len() < 2 {
             return false;
@@ -312,10 +314,7 @@ impl Nester<'_> {
         let mut pairs = Vec::new();
         for slot in 0..self.sheets[s].parts.len() {
             let (part, key, _) = self.sheets[s].parts[slot];
-            let transform = self.sheets[s].layout.placed_items()[key]
-                .d_transf()
-                .compose();
-            for (other, overlap) in self.overlaps_of(s, part, key, &transform) {
+            for (other, overlap) in self.overlaps_of(s, part, key) {
                 if part < other {
                     pairs.push((part, other, overlap));
                 }
@@ -349,17 +348,14 @@ impl Nester<'_> {
     }
 
     /// The parts a placed part collides with, and the overlap with each.
-    fn overlaps_of(
-        &mut self,
-        s: usize,
-        part: usize,
-        key: PItemKey,
-        transform: &Transformation,
-    ) -> Vec<(usize, f32)> {
+    fn overlaps_of(&mut self, s: usize, part: usize, key: PItemKey) -> Vec<(usize, f32)> {
         let parts = self.parts;
         self.collect_collisions_of(s, key);
+        let transform = self.sheets[s].layout.placed_items()[key]
+            .d_transf()
+            .compose();
         let scratch = &mut self.overlap;
-        pose_discs(&parts[part].discs, transform, &mut scratch.mine);
+        pose_discs(&parts[part].discs, &transform, &mut scratch.mine);
         let mut found = Vec::new();
         for (_, entity) in scratch.collector.iter() {
             if let BasicHazardEntity::PlacedItem { id, dt, pk } = entity {
@@ -531,19 +527,9 @@ impl Nester<'_> {
 
 #[cfg(test)]
 mod tests {
-    use glam::DVec2;
-
+    use super::super::super::test_rectangle as rectangle;
     use super::super::{prepare, NestOptions, Nester, SheetSpec};
     use super::*;
-
-    fn rectangle(w: f64, h: f64) -> Vec<DVec2> {
-        vec![
-            DVec2::new(0.0, 0.0),
-            DVec2::new(w, 0.0),
-            DVec2::new(w, h),
-            DVec2::new(0.0, h),
-        ]
-    }
 
     fn options() -> NestOptions {
         NestOptions {
