@@ -45,7 +45,7 @@ fn flat_panels(job: &Job, mesh: &Mesh) -> Vec<FlatPanel> {
         .iter()
         .map(|p| {
             let mut flat = flatten(p).expect("unrolls");
-            fit_labels(&mut flat, LabelOptions::default());
+            fit_labels(&mut flat, &p.labels, LabelOptions::default());
             flat
         })
         .collect()
@@ -97,7 +97,7 @@ fn schemes_and_flatten(c: &mut Criterion) {
                 b.iter(|| {
                     for p in &output.panels {
                         let mut flat = flatten(p).unwrap();
-                        fit_labels(&mut flat, LabelOptions::default());
+                        fit_labels(&mut flat, &p.labels, LabelOptions::default());
                     }
                 })
             });

@@ -11,9 +11,9 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use rayon::prelude::*;
 use unfold::config::{BuildOptions, ModelOptions, SchemeName};
-use unfold::flatten::flatten;
+use unfold::flatten::unroll_all;
+use unfold::labels::LabelOptions;
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -55,11 +55,8 @@ fn main() -> anyhow::Result<()> {
     lap("split");
     let output = unfold::scheme::build_panels(scheme, &scheme_mesh.mesh, &job.scheme_options)?;
     lap("scheme");
-    let flat = output
-        .panels
-        .par_iter()
-        .map(flatten)
-        .collect::<Result<Vec<_>, _>>()?;
+    // The pipeline's flatten stage: unrolling and label fitting.
+    let (flat, _) = unroll_all(&output.panels, LabelOptions::default())?;
     lap("flatten");
     let total = start.elapsed().as_secs_f64();
     let peak_kib = memory_kib("VmHWM:").unwrap_or(0);

@@ -7,6 +7,9 @@ use std::collections::{BTreeMap, VecDeque};
 
 use glam::{DVec2, DVec3};
 
+use rayon::prelude::*;
+
+use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
 use crate::panel::{FacetFrame, FlatHole, FlatPanel, Panel};
 use crate::plane::signed_area;
@@ -167,11 +170,36 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
         outline,
         scores,
         holes,
-        wanted_labels: panel.labels.clone(),
         labels: Vec::new(),
         developability_error,
         area,
     })
+}
+
+/// Unrolls every panel and fits its labels (the pipeline's flatten stage), in
+/// parallel; the flat panels come in panel order, with how many labels were left out.
+/// On failure the error is that of the first panel, in panel order, that fails,
+/// whatever the thread count.
+pub fn unroll_all(
+    panels: &[Panel],
+    options: LabelOptions,
+) -> Result<(Vec<FlatPanel>, LeftOut), FlattenError> {
+    let unrolled: Vec<Result<(FlatPanel, LeftOut), FlattenError>> = panels
+        .par_iter()
+        .map(|panel| {
+            let mut flat = flatten(panel)?;
+            let left_out = fit_labels(&mut flat, &panel.labels, options);
+            Ok((flat, left_out))
+        })
+        .collect();
+    let mut flat = Vec::with_capacity(unrolled.len());
+    let mut left_out = LeftOut::default();
+    for result in unrolled {
+        let (panel, dropped) = result?;
+        flat.push(panel);
+        left_out = left_out + dropped;
+    }
+    Ok((flat, left_out))
 }
 
 /// Chains the edges used by one facet into loops, outer (largest area, counter-

@@ -5,7 +5,7 @@
 use glam::DVec2;
 
 use crate::font::text_strokes;
-use crate::panel::{FlatLabel, FlatPanel, LabelKind};
+use crate::panel::{FlatLabel, FlatPanel, Label, LabelKind};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
 
 /// Label fitting settings (mm).
@@ -78,16 +78,22 @@ impl std::ops::Add for LeftOut {
     }
 }
 
-/// Fits the panel's wanted labels; returns how many of each kind were left out. Panel
-/// ids go first, then partner ids, then marks, so the important ones get the room.
-pub fn fit_labels(panel: &mut FlatPanel, options: LabelOptions) -> LeftOut {
-    let mut order: Vec<usize> = (0..panel.wanted_labels.len()).collect();
-    order.sort_by_key(|&i| (panel.wanted_labels[i].kind, i));
+/// Fits the labels a scheme wants on a panel (the 3D panel's labels, mapped
+/// through the flat panel's facet frames); returns how many of each kind were left
+/// out. Panel ids go first, then partner ids, then marks, so the important ones get
+/// the room.
+pub fn fit_labels(
+    panel: &mut FlatPanel,
+    wanted_labels: &[Label],
+    options: LabelOptions,
+) -> LeftOut {
+    let mut order: Vec<usize> = (0..wanted_labels.len()).collect();
+    order.sort_by_key(|&i| (wanted_labels[i].kind, i));
     let mut placed: Vec<[DVec2; 4]> = Vec::new();
     let mut labels = Vec::new();
     let mut dropped = LeftOut::default();
     for i in order {
-        let wanted = panel.wanted_labels[i].clone();
+        let wanted = &wanted_labels[i];
         let frame = panel.frames[wanted.facet as usize];
         let mut attempts = vec![Attempt {
             facet: wanted.facet as usize,

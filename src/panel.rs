@@ -195,8 +195,6 @@ pub struct FlatPanel {
     pub scores: Vec<[u32; 2]>,
     /// Fastener holes.
     pub holes: Vec<FlatHole>,
-    /// Labels wanted by the scheme, mapped into the plane (before fitting).
-    pub wanted_labels: Vec<Label>,
     /// Labels after fitting.
     pub labels: Vec<FlatLabel>,
     /// Largest change of a facet edge length between 3D and the plane (mm).

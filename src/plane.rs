@@ -232,6 +232,42 @@ pub fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
     hull
 }
 
+/// The rotation (radians) that turns `points` so that their smallest-area bounding
+/// rectangle is axis-aligned and at least as wide as it is tall: a side of the convex
+/// hull then lies along x. Zero for fewer than three distinct points. Ties keep the
+/// first hull edge, so the answer is deterministic.
+pub fn smallest_box_rotation(points: &[DVec2]) -> f64 {
+    let hull = convex_hull(points);
+    if hull.len() < 3 {
+        return 0.0;
+    }
+    let mut best: Option<(f64, f64)> = None;
+    for (i, &a) in hull.iter().enumerate() {
+        let edge = hull[(i + 1) % hull.len()] - a;
+        if edge.length_squared() == 0.0 {
+            continue;
+        }
+        // Turning by -angle(edge) lays the edge along +x.
+        let turn = DVec2::from_angle(-edge.y.atan2(edge.x));
+        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
+        for &p in &hull {
+            let q = turn.rotate(p);
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        let size = hi - lo;
+        let mut rotation = -edge.y.atan2(edge.x);
+        if size.y > size.x {
+            rotation += std::f64::consts::FRAC_PI_2;
+        }
+        let area = size.x * size.y;
+        if best.is_none_or(|(b, _)| area < b * (1.0 - 1e-9)) {
+            best = Some((area, rotation));
+        }
+    }
+    best.map_or(0.0, |(_, r)| r.rem_euclid(std::f64::consts::TAU))
+}
+
 /// The outline of a simple polygon grown by `r` (r ≥ 0): every edge moved out by `r`,
 /// convex corners rounded by a circumscribed polyline of at most 45° per segment (so
 /// the result contains the true r-neighbourhood and adds at most four points per
@@ -327,5 +363,29 @@ mod offset_tests {
             .iter()
             .any(|p| p.distance(DVec2::new(2.5, 2.5)) < 1e-12));
         assert!(convex_hull(&grown).len() < grown.len());
+    }
+
+    #[test]
+    fn the_smallest_box_rotation_lays_a_turned_rectangle_flat() {
+        // A 40 x 10 rectangle turned by 0.6 rad (and its points in a shuffled
+        // order): turning it back must give a 40 x 10 box, wide side along x.
+        let turn = DVec2::from_angle(0.6);
+        let rect: Vec<DVec2> = [(40.0, 10.0), (0.0, 0.0), (0.0, 10.0), (40.0, 0.0)]
+            .iter()
+            .map(|&(x, y)| turn.rotate(DVec2::new(x, y) + DVec2::new(3.0, -7.0)))
+            .collect();
+        let back = DVec2::from_angle(smallest_box_rotation(&rect));
+        let turned: Vec<DVec2> = rect.iter().map(|&p| back.rotate(p)).collect();
+        let (lo, hi) = turned.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        assert!(((hi - lo) - DVec2::new(40.0, 10.0)).abs().max_element() < 1e-9);
+        // A right triangle's smallest box has its legs along the axes.
+        let triangle = [DVec2::ZERO, DVec2::new(30.0, 0.0), DVec2::new(0.0, 20.0)];
+        let quarter = std::f64::consts::FRAC_PI_2;
+        let off_axis = smallest_box_rotation(&triangle).rem_euclid(quarter);
+        assert!(off_axis.min(quarter - off_axis) < 1e-9);
+        assert_eq!(smallest_box_rotation(&triangle[..2]), 0.0);
     }
 }

@@ -12,8 +12,8 @@ use crate::config::{Job, NonPlanar};
 use crate::error::{Error, InputError, Result};
 use crate::export::manifest::{self, round4, Manifest};
 use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
-use crate::flatten::flatten;
-use crate::labels::{fit_labels, LabelOptions, LeftOut};
+use crate::flatten::unroll_all;
+use crate::labels::{LabelOptions, LeftOut};
 use crate::mesh::planarize::{planarize, PlanarizeOptions, PlanarizeReport};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
@@ -189,15 +189,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
     notes.extend(output.notes.iter().cloned());
     clock.lap("scheme");
 
-    let mut flat: Vec<FlatPanel> = output
-        .panels
-        .par_iter()
-        .map(flatten)
-        .collect::<Vec<_>>()
-        // In panel order, so that the error names the first panel that fails
-        // whatever the thread count.
-        .into_iter()
-        .collect::<std::result::Result<_, _>>()
+    let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
         .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
@@ -221,10 +213,6 @@ pub fn run(job: &Job) -> Result<Outcome> {
             bad.id
         )));
     }
-    let labels_left_out = flat
-        .par_iter_mut()
-        .map(|p| fit_labels(p, LabelOptions::default()))
-        .reduce(LeftOut::default, |a, b| a + b);
     clock.lap("flatten");
 
     let sheet = SheetSpec {
@@ -372,6 +360,8 @@ fn build_manifest(
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
     let lower_bound = (panel_area / usable).ceil() as usize;
+    let outlines: Vec<Vec<glam::DVec2>> = flat.iter().map(|p| p.outer()).collect();
+    let spacing_bound = crate::nest::spacing_lower_bound(&outlines, *sheet);
     let panels = flat
         .iter()
         .zip(&layout.placements)
@@ -444,6 +434,7 @@ fn build_manifest(
             panels: flat.len(),
             sheets: layout.sheets,
             sheets_lower_bound: lower_bound,
+            sheets_spacing_bound: spacing_bound,
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
             cycles: output.cycles.len(),
@@ -492,12 +483,13 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
     );
     let _ = writeln!(
         s,
-        "sheets: {} of {} ({:.1} x {:.1} mm); area lower bound {}; utilization {:.1}%",
+        "sheets: {} of {} ({:.1} x {:.1} mm); area lower bound {} ({} counting the spacing); utilization {:.1}%",
         c.sheets,
         m.sheet.name,
         m.sheet.width,
         m.sheet.height,
         c.sheets_lower_bound,
+        c.sheets_spacing_bound,
         100.0 * m.utilization
     );
     if !m.cycles.is_empty() {

@@ -826,11 +826,11 @@ fn labels_are_inside_their_panels() {
     // Library level: every panel carries its own id and, with tabs, the partner's id at
     // each connection: 50 panel ids + 2 × 100 partner ids, none left out.
     let job = half_edge_job(&path, "300mm", 0, &out);
-    let (mesh, connections, _panels, mut flat) = panels_of(&job);
+    let (mesh, connections, panels, mut flat) = panels_of(&job);
     assert_eq!(connections, 100);
     let mut left_out = 0;
-    for fp in &mut flat {
-        left_out += unfold::labels::fit_labels(fp, Default::default()).total();
+    for (fp, panel) in flat.iter_mut().zip(&panels) {
+        left_out += unfold::labels::fit_labels(fp, &panel.labels, Default::default()).total();
     }
     assert_eq!(left_out, 0);
     let mut partner_labels = 0;

@@ -152,6 +152,9 @@ pub struct Counts {
     pub sheets: usize,
     /// ceil(total panel area / usable sheet area).
     pub sheets_lower_bound: usize,
+    /// ceil(total area of the outlines grown by half the spacing / usable sheet area
+    /// grown by half the spacing): the lower bound that counts the spacing.
+    pub sheets_spacing_bound: usize,
     /// Holes in the files.
     pub holes: usize,
     /// Connections between panels.

@@ -188,6 +188,34 @@ pub fn lay_out(
     })
 }
 
+/// The sheets needed if the outlines, each grown by half the spacing, filled the usable
+/// sheet grown by half the spacing without a gap: `ceil(total grown area / grown usable
+/// area)`. Every layout needs at least this many sheets, and unlike the plain area
+/// bound it counts the spacing, which is most of the waste when parts are small.
+///
+/// The grown area of an outline is that of its offset polygon less the most its
+/// rounded corners can add over true arcs (`(8 tan 22.5° - pi) r^2`), so the figure
+/// stays a lower bound; an outline whose offset overlaps itself (a concavity narrower
+/// than the spacing) counts its plain area.
+pub fn spacing_lower_bound(outlines: &[Vec<DVec2>], sheet: SheetSpec) -> usize {
+    let r = 0.5 * sheet.spacing.max(0.0);
+    let corner_excess = (8.0 * (std::f64::consts::PI / 8.0).tan() - std::f64::consts::PI) * r * r;
+    let grown: f64 = outlines
+        .iter()
+        .map(|outline| {
+            let area = crate::plane::area(outline);
+            let offset = crate::plane::offset_outline(outline, r);
+            if r > 0.0 && crate::plane::is_simple(&offset) {
+                (crate::plane::area(&offset) - corner_excess).max(area)
+            } else {
+                area
+            }
+        })
+        .sum();
+    let usable = (sheet.usable_width() + 2.0 * r) * (sheet.usable_height() + 2.0 * r);
+    (grown / usable).ceil() as usize
+}
+
 /// A part too large for the sheet.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 #[error("part {part} is {width:.1} x {height:.1} mm at its most compact rotation and does not fit the usable {usable_width:.1} x {usable_height:.1} mm of the sheet")]

@@ -297,13 +297,18 @@ fn prepare_part(
     let shape = item.shape_cd().as_ref().clone();
     let mut turned = shape.clone();
     let steps = options.rotations.max(1);
+    // Steps are counted from the part's own axis (its smallest bounding rectangle laid
+    // flat): the flattened frame means nothing, and straight sides along the sheet's
+    // axes pack in rows.
+    let axis = crate::plane::smallest_box_rotation(outline);
     let mut orientations = Vec::new();
     for mirrored in [false, true] {
         if mirrored && !options.mirror {
             continue;
         }
         for k in 0..steps {
-            let rotation = (std::f64::consts::TAU * f64::from(k) / f64::from(steps)) as f32;
+            let rotation = (axis + std::f64::consts::TAU * f64::from(k) / f64::from(steps))
+                .rem_euclid(std::f64::consts::TAU) as f32;
             let pose = DTransformation::new(rotation, (0.0, 0.0)).with_reflection(mirrored);
             turned.transform_from(&shape, &pose.compose());
             let bb = turned.bbox();
@@ -637,7 +642,13 @@ impl<'a> Nester<'a> {
             found.truncate(REFINED);
         };
         for _ in 0..samples {
-            let o = self.rng.below(p.orientations.len());
+            let n = p.orientations.len();
+            // Half the samples lie square to the part's axis (every quarter turn).
+            let o = if n.is_multiple_of(4) && self.rng.unit() < 0.5 {
+                self.rng.below(4) * (n / 4)
+            } else {
+                self.rng.below(n)
+            };
             let rng = &mut self.rng;
             let Some((px, py)) = self.sheets[s].grid.free_point(|| rng.unit(), 32) else {
                 continue;

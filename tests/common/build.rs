@@ -470,6 +470,13 @@ pub fn check_output(
         sheets >= lower,
         "{what}: {sheets} sheets below the lower bound {lower}"
     );
+    // The bound that counts the spacing: never below the area bound, never above
+    // the sheets any layout uses.
+    let spacing_bound = count(m, "counts.sheets_spacing_bound");
+    assert!(
+        lower <= spacing_bound && spacing_bound <= sheets,
+        "{what}: area bound {lower}, spacing bound {spacing_bound}, {sheets} sheets"
+    );
     let spec = sheet_spec(m);
     let usable = (spec.width - 2.0 * spec.margin) * (spec.height - 2.0 * spec.margin);
     let ratio = panel_area / usable;
