@@ -168,3 +168,67 @@ fn small_components_are_removed() {
     let genus2 = inspect_json(&model("genus2"), &["--min-component", "10"]);
     assert_eq!(count(&genus2, "mesh.faces"), 50, "{genus2}");
 }
+
+/// The deviation the `simplified` note reports (model units).
+fn reported_deviation(path: &std::path::Path, budget: &[&str]) -> f64 {
+    let report = inspect_json(path, budget);
+    let note = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["kind"] == "simplified")
+        .and_then(|n| n["message"].as_str())
+        .expect("a simplified note")
+        .to_string();
+    let tail = note
+        .split("original surface ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{note}"));
+    tail.split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap_or_else(|_| panic!("{note}"))
+}
+
+#[test]
+fn the_deviation_is_measured() {
+    // A flat 8 x 8 grid of squares: whatever the simplifier collapses, the result lies
+    // in the plane and covers the square (its corners are the grid's corners).
+    let tmp = TempDir::new().unwrap();
+    let mut obj = String::new();
+    for j in 0..=8 {
+        for i in 0..=8 {
+            obj.push_str(&format!("v {i} {j} 0\n"));
+        }
+    }
+    for j in 0..8 {
+        for i in 0..8 {
+            let v = |di: usize, dj: usize| (j + dj) * 9 + i + di + 1;
+            obj.push_str(&format!(
+                "f {} {} {} {}\n",
+                v(0, 0),
+                v(1, 0),
+                v(1, 1),
+                v(0, 1)
+            ));
+        }
+    }
+    let grid = tmp.path().join("flat.obj");
+    std::fs::write(&grid, obj).unwrap();
+    let flat = reported_deviation(&grid, &["--target-faces", "20"]);
+    assert!(flat < 1e-9, "flat grid: {flat}");
+    // A curved surface moves, more for a smaller budget, and by a small part of its
+    // size (spot is 0.94 x 1.69 x 1.72 units; at 150 edges it keeps about 100
+    // triangles, so ears and horns move by a tenth of a unit).
+    let Some(shared) = shared_models("the_deviation_is_measured") else {
+        return;
+    };
+    let spot = shared.join("spot.obj");
+    let fine = reported_deviation(&spot, &["--target-edges", "1500"]);
+    let coarse = reported_deviation(&spot, &["--target-edges", "150"]);
+    assert!(
+        0.0 < fine && fine < 0.05 && fine < coarse && coarse < 0.3,
+        "{fine} {coarse}"
+    );
+}
