@@ -248,7 +248,8 @@ pub fn smallest_box_rotation(points: &[DVec2]) -> f64 {
             continue;
         }
         // Turning by -angle(edge) lays the edge along +x.
-        let turn = DVec2::from_angle(-edge.y.atan2(edge.x));
+        let mut rotation = -edge.y.atan2(edge.x);
+        let turn = DVec2::from_angle(rotation);
         let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
         for &p in &hull {
             let q = turn.rotate(p);
@@ -256,7 +257,6 @@ pub fn smallest_box_rotation(points: &[DVec2]) -> f64 {
             hi = hi.max(q);
         }
         let size = hi - lo;
-        let mut rotation = -edge.y.atan2(edge.x);
         if size.y > size.x {
             rotation += std::f64::consts::FRAC_PI_2;
         }

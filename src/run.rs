@@ -246,6 +246,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         time_limit: search.time_limit.map(|t| t.as_secs_f64()),
         shelf_sheets: nested.shelf_sheets,
     };
+    let spacing_bound = nested.spacing_bound;
     let layout = nested.layout;
     clock.lap("nest");
 
@@ -321,6 +322,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         labels_left_out,
         sheet_entries,
         nesting,
+        spacing_bound,
     );
     let json = serde_json::to_string_pretty(&manifest)
         .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
@@ -354,14 +356,13 @@ fn build_manifest(
     labels_left_out: LeftOut,
     sheets: Vec<manifest::SheetEntry>,
     nesting: manifest::Nesting,
+    spacing_bound: usize,
 ) -> Manifest {
     let o = &job.scheme_options;
     let sheet = &layout.sheet;
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
     let lower_bound = (panel_area / usable).ceil() as usize;
-    let outlines: Vec<Vec<glam::DVec2>> = flat.iter().map(|p| p.outer()).collect();
-    let spacing_bound = crate::nest::spacing_lower_bound(&outlines, *sheet);
     let panels = flat
         .iter()
         .zip(&layout.placements)

@@ -185,9 +185,9 @@ fn deviation(positions: &[glam::DVec3], indices: &[u32], simplified: &Mesh) -> f
     let triangles: Vec<[glam::DVec3; 3]> = simplified
         .faces()
         .map(|f| {
-            let mut corners = simplified.face_positions(f);
-            let mut next = || corners.next().unwrap_or_default();
-            [next(), next(), next()]
+            // The simplified mesh is built from the simplifier's triangles.
+            let corners: Vec<glam::DVec3> = simplified.face_positions(f).collect();
+            [corners[0], corners[1], corners[2]]
         })
         .collect();
     let grid = super::distance::TriangleGrid::new(&triangles);

@@ -154,6 +154,8 @@ pub struct Nested {
     pub shelf_sheets: usize,
     /// Sheets of the true-shape search when its result was dropped for the shelf's.
     pub dropped_search_sheets: Option<usize>,
+    /// The lower bound that counts the spacing ([`spacing_lower_bound`]).
+    pub spacing_bound: usize,
 }
 
 /// Lays out parts (outer outlines in mm, with their areas for the sheet order) with
@@ -185,6 +187,7 @@ pub fn lay_out(
         nester,
         shelf_sheets,
         dropped_search_sheets,
+        spacing_bound: spacing_lower_bound(outlines, sheet),
     })
 }
 
@@ -198,17 +201,19 @@ pub fn lay_out(
 /// stays a lower bound; an outline whose offset overlaps itself (a concavity narrower
 /// than the spacing) counts its plain area.
 pub fn spacing_lower_bound(outlines: &[Vec<DVec2>], sheet: SheetSpec) -> usize {
+    use crate::plane::{area, is_simple, offset_outline};
+    use std::f64::consts::PI;
     let r = 0.5 * sheet.spacing.max(0.0);
-    let corner_excess = (8.0 * (std::f64::consts::PI / 8.0).tan() - std::f64::consts::PI) * r * r;
+    let corner_excess = (8.0 * (PI / 8.0).tan() - PI) * r * r;
     let grown: f64 = outlines
         .iter()
         .map(|outline| {
-            let area = crate::plane::area(outline);
-            let offset = crate::plane::offset_outline(outline, r);
-            if r > 0.0 && crate::plane::is_simple(&offset) {
-                (crate::plane::area(&offset) - corner_excess).max(area)
+            let bare = area(outline);
+            let offset = offset_outline(outline, r);
+            if r > 0.0 && is_simple(&offset) {
+                (area(&offset) - corner_excess).max(bare)
             } else {
-                area
+                bare
             }
         })
         .sum();
@@ -238,4 +243,34 @@ pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
         (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
         |(lo, hi), p| (lo.min(p), hi.max(p)),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_spacing_bound_counts_the_grown_squares() {
+        // Usable 100 x 100 mm, spacing 2 mm: the grown sheet is 102 x 102 = 10404 mm²
+        // and a grown 10 mm square 100 + 4·10·1 + π·1² = 143.14 mm², so 72 squares
+        // (10306 mm²) fit one sheet's area and 73 (10449 mm²) do not, while the bare
+        // area bound stays at one sheet up to 100 squares.
+        let sheet = SheetSpec {
+            width: 110.0,
+            height: 110.0,
+            margin: 5.0,
+            spacing: 2.0,
+        };
+        let squares = |n: usize| vec![test_rectangle(10.0, 10.0); n];
+        assert_eq!(spacing_lower_bound(&squares(72), sheet), 1);
+        assert_eq!(spacing_lower_bound(&squares(73), sheet), 2);
+        assert_eq!(spacing_lower_bound(&squares(100), sheet), 2);
+        // Without spacing it is the area bound.
+        let touching = SheetSpec {
+            spacing: 0.0,
+            ..sheet
+        };
+        assert_eq!(spacing_lower_bound(&squares(100), touching), 1);
+        assert_eq!(spacing_lower_bound(&squares(101), touching), 2);
+    }
 }
