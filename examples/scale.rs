@@ -59,6 +59,17 @@ fn main() -> anyhow::Result<()> {
     let (flat, _) = unroll_all(&output.panels, LabelOptions::default())?;
     lap("flatten");
     let total = start.elapsed().as_secs_f64();
+    let per_panel = |count: &dyn Fn(&unfold::panel::Panel) -> usize| {
+        output.panels.iter().map(count).sum::<usize>() as f64 / output.panels.len().max(1) as f64
+    };
+    println!(
+        "per panel: {:.1} vertices, {:.1} facets, {:.1} holes, {:.1} labels ({:.1} fitted)",
+        per_panel(&|p| p.vertices.len()),
+        per_panel(&|p| p.facets.len()),
+        per_panel(&|p| p.holes.len()),
+        per_panel(&|p| p.labels.len()),
+        flat.iter().map(|p| p.labels.len()).sum::<usize>() as f64 / flat.len().max(1) as f64,
+    );
     let peak_kib = memory_kib("VmHWM:").unwrap_or(0);
     println!(
         "{faces} faces, {} panels, {} flat; load → flatten {total:.2} s; peak memory {} MiB ({:.1} × the {} MiB input file)",

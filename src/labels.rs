@@ -4,7 +4,7 @@
 
 use glam::DVec2;
 
-use crate::font::text_strokes;
+use crate::font::text_width;
 use crate::panel::{FlatLabel, FlatPanel, Label, LabelKind};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
 
@@ -107,7 +107,7 @@ pub fn fit_labels(
             // small, try the panel's largest facets.
             attempts.extend(fallback_attempts(panel, wanted.facet as usize));
         }
-        let text_width = text_strokes(&wanted.text).width;
+        let text_width = text_width(&wanted.text);
         let fitted = attempts.iter().find_map(|attempt| {
             fit_one(panel, attempt, text_width, wanted.height, &placed, options)
         });

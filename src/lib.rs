@@ -26,7 +26,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-pub use config::{BuildOptions, Job, ModelOptions, ModelSettings};
+pub use config::{BuildOptions, Job, ModelOptions, ModelSettings, NonPlanar};
 pub use error::{Error, InputError, Result};
 pub use run::{report_text, run, Outcome};
 
@@ -148,8 +148,13 @@ pub struct Inspection {
     pub ignored: Vec<(String, usize)>,
     /// Repairs and observations.
     pub notes: Vec<Note>,
-    /// Faces each kind of scheme would split before building panels.
+    /// Faces each kind of scheme would split before building panels (after
+    /// planarization, with `--nonplanar planarize`).
     pub preparation: Preparation,
+    /// The non-planar face policy the preview assumes.
+    pub nonplanar: NonPlanar,
+    /// What `--nonplanar planarize` would do (displacement in mm, as built).
+    pub planarized: Option<mesh::planarize::PlanarizeReport>,
 }
 
 /// What preparation would do before building panels, per kind of scheme.
@@ -161,31 +166,51 @@ pub struct Preparation {
     pub edge_schemes: [usize; 2],
 }
 
-/// Reads, checks and measures a model. Errors if it cannot be built at all.
-pub fn inspect(path: &Path, settings: &ModelSettings) -> Result<Inspection> {
+/// Reads, checks and measures a model, and previews what preparation would do with
+/// non-planar faces under `nonplanar` (planarization is run, on a copy scaled as the
+/// build scales it). Errors if it cannot be built at all.
+pub fn inspect(path: &Path, settings: &ModelSettings, nonplanar: NonPlanar) -> Result<Inspection> {
     let (raw, prepared) = load_model(path, settings)?;
-    let mesh = &prepared.mesh;
-    let geometry = mesh.geometry_facts(settings.planarity_tol);
+    let geometry = prepared.mesh.geometry_facts(settings.planarity_tol);
     let mm = settings.checked_mm_per_unit(path, geometry.longest_side())?;
     let size_mm = [0, 1, 2].map(|k| (geometry.bbox_max[k] - geometry.bbox_min[k]) * mm);
     let mut notes = prepared.notes.clone();
+    let mut planarized = None;
+    let mut mesh = std::borrow::Cow::Borrowed(&prepared.mesh);
+    if nonplanar == NonPlanar::Planarize && geometry.non_planar_faces > 0 {
+        let mut built = prepared.mesh.clone();
+        built.scale(mm);
+        planarized = Some(run::planarize_faces(
+            path,
+            &mut built,
+            settings.planarity_tol,
+        )?);
+        mesh = std::borrow::Cow::Owned(built);
+    }
     if geometry.non_planar_faces > 0 {
+        let policy = match nonplanar {
+            NonPlanar::Triangulate => "they will be triangulated when panels are built",
+            NonPlanar::Planarize => {
+                "--nonplanar planarize moves vertices to make them planar (see the planarize line)"
+            }
+            NonPlanar::Error => "with --nonplanar error the build refuses this model",
+        };
         notes.push(Note {
             kind: "non-planar-faces",
             message: format!(
-                "{} faces are not planar within {} of their size (worst: face {} at {:.2e}); they will be triangulated when panels are built",
+                "{} faces are not planar within {} of their size (worst: face {} at {:.2e}); {policy}",
                 geometry.non_planar_faces,
                 settings.planarity_tol,
                 geometry
                     .least_planar_face
-                    .map(|f| mesh.face_source(mesh::FaceId(f)))
+                    .map(|f| prepared.mesh.face_source(mesh::FaceId(f)))
                     .unwrap_or(0),
                 geometry.max_planarity_error
             ),
         });
     }
     let split = |convex| {
-        let r = mesh::split::faces_to_split(&prepared.mesh, settings.planarity_tol, convex);
+        let r = mesh::split::faces_to_split(&mesh, settings.planarity_tol, convex);
         [r.non_planar.len(), r.not_star_shaped.len()]
     };
     let preparation = Preparation {
@@ -208,6 +233,8 @@ pub fn inspect(path: &Path, settings: &ModelSettings) -> Result<Inspection> {
         groups: raw.groups.clone(),
         ignored: raw.ignored.clone(),
         notes,
+        nonplanar,
+        planarized,
     })
 }
 
@@ -309,6 +336,20 @@ impl Inspection {
             "planarity:   max error {:.3e}; {} faces above {}",
             g.max_planarity_error, g.non_planar_faces, g.planarity_tolerance
         );
+        if let Some(r) = &self.planarized {
+            let _ = writeln!(
+                s,
+                "planarize:   {} of {} faces with four or more corners over the tolerance -> {}; max error {:.3e} -> {:.3e} in {} iterations; largest vertex move {} mm built ({} model units)",
+                r.non_planar_before,
+                r.polygons,
+                r.non_planar_after,
+                r.max_error_before,
+                r.max_error_after,
+                r.iterations,
+                short_number(r.max_displacement),
+                short_number(r.max_displacement / self.physical.mm_per_unit)
+            );
+        }
         let p = &self.preparation;
         let _ = writeln!(
             s,

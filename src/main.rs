@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
-use unfold::config::{load_config, BuildOptions, ModelOptions};
+use unfold::config::{load_config, BuildOptions, ModelOptions, NonPlanar};
 use unfold::{Error, Result};
 
 /// Turn a 3D polygon mesh into developable flat panels laid out on laser-cutter sheets.
@@ -66,6 +66,12 @@ enum Command {
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
 
+        /// Preview this non-planar face policy: triangulate, planarize (runs the
+        /// planarization and reports the errors before and after and the largest vertex
+        /// move) or error. [default: triangulate]
+        #[arg(long, value_name = "POLICY")]
+        nonplanar: Option<NonPlanar>,
+
         #[command(flatten)]
         options: ModelOptions,
     },
@@ -119,6 +125,7 @@ fn run(cli: Cli) -> Result<()> {
             model,
             json,
             config,
+            nonplanar,
             options,
         }) => {
             let options = match config {
@@ -126,7 +133,8 @@ fn run(cli: Cli) -> Result<()> {
                 None => options,
             };
             let settings = options.resolve()?;
-            let report = unfold::inspect(&model, &settings)?;
+            let nonplanar = nonplanar.unwrap_or(NonPlanar::Triangulate);
+            let report = unfold::inspect(&model, &settings, nonplanar)?;
             let text = if json {
                 serde_json::to_string_pretty(&report)
                     .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?

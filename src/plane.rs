@@ -42,6 +42,15 @@ pub fn signed_area(poly: &[DVec2]) -> f64 {
         .sum::<f64>()
 }
 
+/// `signed_area` of the polygon whose corners are `points[i]` for `i` in `indices`
+/// (the same sum in the same order, without collecting the corners).
+pub fn loop_signed_area(points: &[DVec2], indices: &[u32]) -> f64 {
+    let n = indices.len();
+    0.5 * (0..n)
+        .map(|i| points[indices[i] as usize].perp_dot(points[indices[(i + 1) % n] as usize]))
+        .sum::<f64>()
+}
+
 /// The polygon's corners in counter-clockwise order (reversed when clockwise).
 pub fn counter_clockwise(poly: &[DVec2]) -> Vec<DVec2> {
     if signed_area(poly) < 0.0 {

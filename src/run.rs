@@ -92,16 +92,11 @@ pub fn scheme_mesh(
         .checked_mm_per_unit(&job.model_path, geometry.longest_side())?;
     mesh.scale(mm_per_unit);
     let planarized = if job.nonplanar == NonPlanar::Planarize {
-        let options = PlanarizeOptions {
-            tolerance: job.model.planarity_tol,
-            ..PlanarizeOptions::default()
-        };
-        Some(planarize(&mut mesh, &options).map_err(|e| {
-            Error::Runtime(format!(
-                "{}: {e}; use --nonplanar triangulate",
-                job.model_path.display()
-            ))
-        })?)
+        Some(planarize_faces(
+            &job.model_path,
+            &mut mesh,
+            job.model.planarity_tol,
+        )?)
     } else {
         None
     };
@@ -134,6 +129,25 @@ pub fn scheme_mesh(
         split,
         mm_per_unit,
         planarized,
+    })
+}
+
+/// `--nonplanar planarize` on a mesh in millimetres: the build's step, shared with
+/// `inspect` so its preview is the same computation.
+pub fn planarize_faces(
+    model_path: &std::path::Path,
+    mesh: &mut crate::mesh::Mesh,
+    planarity_tol: f64,
+) -> Result<PlanarizeReport> {
+    let options = PlanarizeOptions {
+        tolerance: planarity_tol,
+        ..PlanarizeOptions::default()
+    };
+    planarize(mesh, &options).map_err(|e| {
+        Error::Runtime(format!(
+            "{}: {e}; use --nonplanar triangulate",
+            model_path.display()
+        ))
     })
 }
 

@@ -9,7 +9,9 @@ use std::path::Path;
 use glam::DVec3;
 use tempfile::TempDir;
 
-use common::build::{build_run, check_sheets, model, options, shared_models, DxfCheck};
+use common::build::{
+    build_run, check_sheets, inspect_json, model, options, shared_models, DxfCheck,
+};
 use unfold::config::{Job, NonPlanar, SchemeName};
 use unfold::mesh::geometry::planarity_error;
 use unfold::run::{scheme_mesh, SchemeMesh};
@@ -98,6 +100,44 @@ fn suzanne_quads_and_fertility_ngons_become_planar() {
     };
     check_planarized(&shared.join("suzanne.obj"), "suzanne");
     check_planarized(&shared.join("fertility.obj"), "fertility");
+}
+
+#[test]
+fn inspect_previews_the_planarization_the_build_does() {
+    let Some(shared) = shared_models("planarize") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let path = shared.join("suzanne.obj");
+    let build = mesh_for(&job(&path, NonPlanar::Planarize, tmp.path()))
+        .planarized
+        .expect("a report");
+    let preview = inspect_json(&path, &["--size", "4ft", "--nonplanar", "planarize"]);
+    let planarized = &preview["planarized"];
+    assert_eq!(preview["nonplanar"], "planarize");
+    for (key, value) in [
+        ("polygons", build.polygons),
+        ("non_planar_before", build.non_planar_before),
+        ("non_planar_after", build.non_planar_after),
+        ("iterations", build.iterations),
+    ] {
+        assert_eq!(planarized[key].as_u64(), Some(value as u64), "{key}");
+    }
+    // The same computation on the same scaled mesh: the same move (mm), not an estimate.
+    assert_eq!(
+        planarized["max_displacement"].as_f64(),
+        Some(build.max_displacement)
+    );
+    assert!(build.max_displacement > 1.0, "suzanne's quads move at 4 ft");
+    // After planarization nothing is split for planarity; without it, 440 faces are.
+    assert_eq!(preview["preparation"]["half_edge"][0], 0);
+    let triangulate = inspect_json(&path, &["--size", "4ft"]);
+    assert!(triangulate["planarized"].is_null());
+    assert_eq!(triangulate["nonplanar"], "triangulate");
+    assert_eq!(
+        triangulate["preparation"]["half_edge"][0].as_u64(),
+        Some(build.non_planar_before as u64)
+    );
 }
 
 #[test]

@@ -44,7 +44,7 @@ impl Default for PlanarizeOptions {
 }
 
 /// What planarization did.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct PlanarizeReport {
     /// Faces of four or more corners (the constrained ones).
     pub polygons: usize,
