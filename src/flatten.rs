@@ -47,7 +47,7 @@ const FLAT_FOLD: f64 = 1e-9;
 /// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
 /// first edge along +x); every other facet is placed across a hinge.
 pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
-    let fail_id = || panel.id.clone();
+    let fail_id = || panel.id().to_string();
     let normals: Vec<DVec3> = panel
         .facets
         .iter()
@@ -67,7 +67,7 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
 
     // Every facet edge once per use, grouped by its two vertices (smaller first); the
     // stable sort keeps the uses of an edge in facet order.
-    let mut edges: Vec<EdgeUse> = Vec::with_capacity(panel.facets.iter().map(Vec::len).sum());
+    let mut edges: Vec<EdgeUse> = Vec::with_capacity(panel.facets.index_count());
     for (k, facet) in panel.facets.iter().enumerate() {
         for i in 0..facet.len() {
             let (from, to) = (facet[i], facet[(i + 1) % facet.len()]);
@@ -181,12 +181,11 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
         })
         .collect();
     Ok(FlatPanel {
-        id: panel.id.clone(),
         source: panel.source,
         points,
         facets: panel.facets.clone(),
         frames,
-        outline,
+        outline: outline.into_iter().collect(),
         scores,
         holes,
         labels: Vec::new(),

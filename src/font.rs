@@ -61,29 +61,53 @@ fn glyph_metrics() -> &'static [GlyphMetrics; 95] {
 }
 
 /// The width of a text at cap height 1: the same figure as `text_strokes(text).width`,
-/// without rendering the strokes (label fitting needs only this, for every label of
-/// every panel).
-pub fn text_width(text: &str) -> f64 {
-    let table = glyph_metrics();
-    let (mut pen, mut lo, mut hi) = (0i32, i32::MAX, i32::MIN);
-    for c in text.chars().filter(|c| (' '..='~').contains(c)) {
-        let glyph = table[c as usize - ' ' as usize];
-        if let Some((a, b)) = glyph.extent {
-            lo = lo.min(pen + a);
-            hi = hi.max(pen + b);
-        }
-        pen += glyph.advance;
-    }
-    if lo > hi {
+/// without rendering the strokes or building the string (label fitting needs only
+/// this, for every label of every panel).
+pub fn text_width(text: impl std::fmt::Display) -> f64 {
+    use std::fmt::Write;
+    let mut meter = WidthMeter {
+        table: glyph_metrics(),
+        pen: 0,
+        lo: i32::MAX,
+        hi: i32::MIN,
+    };
+    let _ = write!(meter, "{text}");
+    if meter.lo > meter.hi {
         0.0
     } else {
-        (hi - lo) as f64 / CAP_UNITS
+        (meter.hi - meter.lo) as f64 / CAP_UNITS
+    }
+}
+
+/// Lays characters out as the renderer does, keeping only the extent.
+struct WidthMeter {
+    table: &'static [GlyphMetrics; 95],
+    pen: i32,
+    lo: i32,
+    hi: i32,
+}
+
+impl std::fmt::Write for WidthMeter {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for c in s.chars().filter(|c| (' '..='~').contains(c)) {
+            let glyph = self.table[c as usize - ' ' as usize];
+            if let Some((a, b)) = glyph.extent {
+                self.lo = self.lo.min(self.pen + a);
+                self.hi = self.hi.max(self.pen + b);
+            }
+            self.pen += glyph.advance;
+        }
+        Ok(())
     }
 }
 
 /// The strokes of an ASCII text. Characters outside printable ASCII are skipped.
-pub fn text_strokes(text: &str) -> TextStrokes {
-    let ascii: String = text.chars().filter(|c| (' '..='~').contains(c)).collect();
+pub fn text_strokes(text: impl std::fmt::Display) -> TextStrokes {
+    let ascii: String = text
+        .to_string()
+        .chars()
+        .filter(|c| (' '..='~').contains(c))
+        .collect();
     let points = render(&ascii);
     let min_x = points.iter().map(|p| p.x).min().unwrap_or(0) as f64;
     let mut polylines: Vec<Vec<DVec2>> = Vec::new();
@@ -145,7 +169,11 @@ mod tests {
             }
         }
         for text in &texts {
-            assert_eq!(text_width(text), text_strokes(text).width, "{text:?}");
+            assert_eq!(
+                text_width(text.as_str()),
+                text_strokes(text.as_str()).width,
+                "{text:?}"
+            );
         }
     }
 

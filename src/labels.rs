@@ -107,7 +107,7 @@ pub fn fit_labels(
             // small, try the panel's largest facets.
             attempts.extend(fallback_attempts(panel, wanted.facet as usize));
         }
-        let text_width = text_width(&wanted.text);
+        let text_width = text_width(wanted.text);
         let fitted = attempts.iter().find_map(|attempt| {
             fit_one(panel, attempt, text_width, wanted.height, &placed, options)
         });
@@ -115,7 +115,7 @@ pub fn fit_labels(
             Some((center, direction, height, bx)) => {
                 placed.push(bx);
                 labels.push(FlatLabel {
-                    text: wanted.text.clone(),
+                    text: wanted.text,
                     center,
                     direction,
                     height,

@@ -25,6 +25,50 @@ pub enum Source {
     },
 }
 
+impl Source {
+    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    pub fn name(self) -> Name {
+        match self {
+            Source::Face(f) => Name::Face(f),
+            Source::Edge(e) => Name::Edge(e),
+            Source::Cycle { cycle, segment } => Name::Segment { cycle, segment },
+        }
+    }
+}
+
+/// A printed name: a panel's id, or what a label says. Kept as the element it names
+/// and printed on demand, so a million panels carry no strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Name {
+    /// A face: `F12` (half-edge panel ids, face marks).
+    Face(u32),
+    /// An edge: `E123` (edge panel ids).
+    Edge(u32),
+    /// A vertex: `V7` (corner marks).
+    Vertex(u32),
+    /// A woven cycle: `C3` (1-based).
+    Cycle(u32),
+    /// A segment of a woven cycle: `C3.2` (both 1-based).
+    Segment {
+        /// The cycle (1-based).
+        cycle: u32,
+        /// The segment along it (1-based).
+        segment: u32,
+    },
+}
+
+impl std::fmt::Display for Name {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Name::Face(k) => write!(f, "F{k}"),
+            Name::Edge(k) => write!(f, "E{k}"),
+            Name::Vertex(k) => write!(f, "V{k}"),
+            Name::Cycle(k) => write!(f, "C{k}"),
+            Name::Segment { cycle, segment } => write!(f, "C{cycle}.{segment}"),
+        }
+    }
+}
+
 /// A fastener hole: a circle at a 3D point on one facet, shared with the partner panel
 /// of its connection (the partner has a hole at the same 3D point).
 #[derive(Clone, Debug, PartialEq)]
@@ -56,8 +100,8 @@ pub enum LabelKind {
 /// `direction` (so it sits just inside that edge whatever its final height).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Label {
-    /// ASCII text.
-    pub text: String,
+    /// What it says.
+    pub text: Name,
     /// Anchor (mm).
     pub anchor: DVec3,
     /// Reading direction (unit, in the facet's plane).
@@ -75,21 +119,136 @@ pub struct Label {
     pub slide: f64,
 }
 
+/// Index loops (a panel's facets, a flat panel's cut loops) in one buffer. A panel has
+/// a handful of short loops and a big job has millions of panels: one allocation per
+/// loop would cost more memory than the indices themselves.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Loops {
+    /// Every loop's indices, one loop after the other.
+    indices: Vec<u32>,
+    /// Where each loop ends in `indices`.
+    ends: Vec<u32>,
+}
+
+impl Loops {
+    /// No loops.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Appends a loop.
+    pub fn push(&mut self, lp: impl IntoIterator<Item = u32>) {
+        self.indices.extend(lp);
+        self.ends.push(self.indices.len() as u32);
+    }
+
+    /// Number of loops.
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// No loops at all.
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// Loop `k`, if there is one.
+    pub fn get(&self, k: usize) -> Option<&[u32]> {
+        let end = *self.ends.get(k)? as usize;
+        let start = if k == 0 { 0 } else { self.ends[k - 1] as usize };
+        Some(&self.indices[start..end])
+    }
+
+    /// The first loop.
+    pub fn first(&self) -> Option<&[u32]> {
+        self.get(0)
+    }
+
+    /// The loops in order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[u32]> + DoubleEndedIterator + '_ {
+        (0..self.len()).map(move |k| &self[k])
+    }
+
+    /// Indices in all loops together.
+    pub fn index_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Gives back spare capacity (panels are built once and kept).
+    pub fn shrink_to_fit(&mut self) {
+        self.indices.shrink_to_fit();
+        self.ends.shrink_to_fit();
+    }
+}
+
+impl std::ops::Index<usize> for Loops {
+    type Output = [u32];
+    fn index(&self, k: usize) -> &[u32] {
+        self.get(k)
+            .unwrap_or_else(|| panic!("loop {k} of {}", self.len()))
+    }
+}
+
+impl<'a> IntoIterator for &'a Loops {
+    type Item = &'a [u32];
+    type IntoIter = Box<dyn Iterator<Item = &'a [u32]> + 'a>;
+    fn into_iter(self) -> Self::IntoIter {
+        Box::new(self.iter())
+    }
+}
+
+impl<L: IntoIterator<Item = u32>> FromIterator<L> for Loops {
+    fn from_iter<I: IntoIterator<Item = L>>(loops: I) -> Self {
+        let mut all = Loops::new();
+        for lp in loops {
+            all.push(lp);
+        }
+        all
+    }
+}
+
 /// A panel in 3D, as it sits in the assembled model (millimetres).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Panel {
-    /// The id printed for users (`F12`, `E123`, `C3.2`).
-    pub id: String,
-    /// Provenance.
+    /// Provenance (and so the printed id).
     pub source: Source,
     /// Corner positions shared by the facets.
     pub vertices: Vec<DVec3>,
     /// Planar facets as vertex index loops, counter-clockwise seen from the outside.
-    pub facets: Vec<Vec<u32>>,
+    pub facets: Loops,
     /// Fastener holes.
     pub holes: Vec<Hole>,
     /// Labels.
     pub labels: Vec<Label>,
+}
+
+impl Panel {
+    /// A panel from its parts, holding no spare capacity: the schemes build panels by
+    /// pushing, and a big job keeps millions of them until the end.
+    pub fn new(
+        source: Source,
+        mut vertices: Vec<DVec3>,
+        mut facets: Loops,
+        mut holes: Vec<Hole>,
+        mut labels: Vec<Label>,
+    ) -> Self {
+        vertices.shrink_to_fit();
+        facets.shrink_to_fit();
+        holes.shrink_to_fit();
+        labels.shrink_to_fit();
+        Panel {
+            source,
+            vertices,
+            facets,
+            holes,
+            labels,
+        }
+    }
+
+    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    pub fn id(&self) -> Name {
+        self.source.name()
+    }
 }
 
 /// The isometry between a facet's plane in 3D and its place in the flat panel.
@@ -163,8 +322,8 @@ pub struct FlatHole {
 /// A label in the flat panel, after fitting.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlatLabel {
-    /// ASCII text.
-    pub text: String,
+    /// What it says.
+    pub text: Name,
     /// Centre of the text box.
     pub center: DVec2,
     /// Unit reading direction.
@@ -178,19 +337,17 @@ pub struct FlatLabel {
 /// A panel unrolled into the plane, outside face up (its facets counter-clockwise).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlatPanel {
-    /// The id printed for users.
-    pub id: String,
-    /// Provenance.
+    /// Provenance (and so the printed id).
     pub source: Source,
     /// Corner positions in the plane (same indices as the 3D panel's vertices).
     pub points: Vec<DVec2>,
     /// Facets (same as the 3D panel's).
-    pub facets: Vec<Vec<u32>>,
+    pub facets: Loops,
     /// The isometry of every facet (for mapping holes and labels back to 3D).
     pub frames: Vec<FacetFrame>,
     /// Cut loops: the outer outline first (counter-clockwise), then inner cuts
     /// (clockwise).
-    pub outline: Vec<Vec<u32>>,
+    pub outline: Loops,
     /// Fold lines to score (hinges with a non-zero fold angle).
     pub scores: Vec<[u32; 2]>,
     /// Fastener holes.
@@ -204,6 +361,11 @@ pub struct FlatPanel {
 }
 
 impl FlatPanel {
+    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    pub fn id(&self) -> Name {
+        self.source.name()
+    }
+
     /// The points of an outline loop.
     pub fn loop_points(&self, lp: &[u32]) -> Vec<DVec2> {
         lp.iter().map(|&i| self.points[i as usize]).collect()

@@ -224,7 +224,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         };
         return Err(Error::Runtime(format!(
             "panel {} overlaps itself when unrolled; {advice}",
-            bad.id
+            bad.id()
         )));
     }
     clock.lap("flatten");
@@ -239,7 +239,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
     let too_large = |e: crate::nest::TooLarge| {
         Error::Runtime(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
-            flat[e.part].id, e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
+            flat[e.part].id(), e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))
     };
     let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
@@ -381,7 +381,7 @@ fn build_manifest(
         .iter()
         .zip(&layout.placements)
         .map(|(p, placement)| manifest::PanelEntry {
-            id: p.id.clone(),
+            id: p.id().to_string(),
             sheet: placement.sheet + 1,
             area: round4(p.area),
             source: match p.source {

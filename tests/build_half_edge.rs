@@ -301,7 +301,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
     let mut by_connection: BTreeMap<u32, Vec<(usize, u32, DVec3)>> = BTreeMap::new();
     let mut total = 0;
     for (k, fp) in flat.iter().enumerate() {
-        assert_eq!(fp.holes.len(), panels[k].holes.len(), "{what}: {}", fp.id);
+        assert_eq!(fp.holes.len(), panels[k].holes.len(), "{what}: {}", fp.id());
         for hole in &fp.holes {
             total += 1;
             let facet: Vec<DVec2> = fp.facets[hole.facet as usize]
@@ -311,7 +311,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
             assert!(
                 inside(&facet, hole.center),
                 "{what}: {} hole of connection {} at {} is outside its facet {}",
-                fp.id,
+                fp.id(),
                 hole.connection,
                 hole.center,
                 hole.facet
@@ -320,7 +320,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
             assert!(
                 clear >= r - 1e-9,
                 "{what}: {} hole of connection {} is {clear} mm from its facet's edge, radius {r}",
-                fp.id,
+                fp.id(),
                 hole.connection
             );
             let p = fp.frames[hole.facet as usize].to_3d(hole.center);
@@ -420,7 +420,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
             assert!(
                 nearest <= tol,
                 "{what}: connection {c}: hole of {} at {} has no partner hole on the tab (nearest {nearest} mm)",
-                flat[band_panel].id,
+                flat[band_panel].id(),
                 hb.2
             );
             assert!(
@@ -498,7 +498,7 @@ fn holes_of_a_connection_meet_in_3d_on_near_planar_faces() {
                     && (f.y3.length() - 1.0).abs() < 1e-12
                     && f.x3.dot(f.y3).abs() < 1e-12,
                 "{} facet {k}: frame axes |x3| = {}, |y3| = {}, x3·y3 = {:e}",
-                fp.id,
+                fp.id(),
                 f.x3.length(),
                 f.y3.length(),
                 f.x3.dot(f.y3)
@@ -835,15 +835,15 @@ fn labels_are_inside_their_panels() {
     assert_eq!(left_out, 0);
     let mut partner_labels = 0;
     for fp in &flat {
-        let own: Vec<&str> = fp
+        let own: Vec<String> = fp
             .labels
             .iter()
             .filter(|l| l.kind == LabelKind::Panel)
-            .map(|l| l.text.as_str())
+            .map(|l| l.text.to_string())
             .collect();
-        assert_eq!(own, [fp.id.as_str()], "{}: its own id once", fp.id);
+        assert_eq!(own, [fp.id().to_string()], "{}: its own id once", fp.id());
         let Source::Face(f) = fp.source else {
-            panic!("{}: not a face panel", fp.id)
+            panic!("{}: not a face panel", fp.id())
         };
         // Partner labels name the neighbours across the face's edges.
         let neighbours: BTreeSet<String> = mesh
@@ -853,9 +853,9 @@ fn labels_are_inside_their_panels() {
             .collect();
         for l in fp.labels.iter().filter(|l| l.kind == LabelKind::Partner) {
             assert!(
-                neighbours.contains(&l.text),
+                neighbours.contains(&l.text.to_string()),
                 "{}: partner label {} is not a neighbour",
-                fp.id,
+                fp.id(),
                 l.text
             );
             partner_labels += 1;
@@ -865,7 +865,7 @@ fn labels_are_inside_their_panels() {
             assert!(
                 inside(&fp.outer(), l.center),
                 "{}: label {} outside",
-                fp.id,
+                fp.id(),
                 l.text
             );
         }

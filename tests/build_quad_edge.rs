@@ -73,7 +73,7 @@ fn face_corners(mesh: &Mesh) -> usize {
 fn edge_of(p: &FlatPanel) -> EdgeId {
     match p.source {
         Source::Edge(e) => EdgeId(e),
-        other => panic!("{}: a quad-edge panel made from {other:?}", p.id),
+        other => panic!("{}: a quad-edge panel made from {other:?}", p.id()),
     }
 }
 
@@ -188,7 +188,7 @@ fn rulings(panel: &Panel, n: usize) -> Vec<[u32; 2]> {
                 shared.len(),
                 2,
                 "{}: facets {k} and {} share {shared:?}, not one edge",
-                panel.id,
+                panel.id(),
                 k + 1
             );
             [shared[0], shared[1]]
@@ -231,13 +231,13 @@ fn check_panels(p: &Pipeline, job: &Job, what: &str) {
     );
     for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
         let e = edge_of(fp);
-        assert_eq!(fp.id, format!("E{}", e.0), "{what}: panel id");
+        assert_eq!(fp.id().to_string(), format!("E{}", e.0), "{what}: panel id");
         let facets = if mesh.is_boundary_edge(e) { 1 } else { n + 2 };
         assert_eq!(
             panel.facets.len(),
             facets,
             "{what}: {} ({}) has {} facets",
-            fp.id,
+            fp.id(),
             if facets == 1 {
                 "boundary edge"
             } else {
@@ -245,24 +245,28 @@ fn check_panels(p: &Pipeline, job: &Job, what: &str) {
             },
             panel.facets.len()
         );
-        assert_eq!(fp.outline.len(), 1, "{what}: {} has inner cuts", fp.id);
+        assert_eq!(fp.outline.len(), 1, "{what}: {} has inner cuts", fp.id());
         let outer = fp.outer();
         let size = diameter(&outer, DVec2::distance);
         if let Some(why) = not_simple(&outer, 1e-9 * size) {
-            panic!("{what}: panel {} overlaps itself: {why}", fp.id);
+            panic!("{what}: panel {} overlaps itself: {why}", fp.id());
         }
         let area = signed_area(&outer);
-        assert!(area > 0.0, "{what}: {} is laid face down", fp.id);
+        assert!(area > 0.0, "{what}: {} is laid face down", fp.id());
         let mut facets_area = 0.0;
         for (k, facet) in fp.facets.iter().enumerate() {
             let a = signed_area(&fp.loop_points(facet));
-            assert!(a > 0.0, "{what}: {} facet {k} is flipped ({a} mm²)", fp.id);
+            assert!(
+                a > 0.0,
+                "{what}: {} facet {k} is flipped ({a} mm²)",
+                fp.id()
+            );
             facets_area += a;
         }
         assert!(
             (facets_area - area).abs() <= 1e-9 * area,
             "{what}: {} facets cover {facets_area} mm² of a {area} mm² outline: they overlap",
-            fp.id
+            fp.id()
         );
     }
 }
@@ -286,7 +290,7 @@ fn check_developable(p: &Pipeline, what: &str, rel: f64) -> f64 {
         assert!(
             error <= rel * size && fp.developability_error <= rel * size,
             "{what}: {} changes a facet edge by {error:e} mm (flattener says {:e}) on a {size} mm panel",
-            fp.id,
+            fp.id(),
             fp.developability_error
         );
         worst = worst.max(error / size);
@@ -355,7 +359,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 panel.facets.len(),
                 n + 2,
                 "{what}: {} is not flap + {n} strips + flap",
-                fp.id
+                fp.id()
             );
             let lines = rulings(panel, n);
             // Facet 0 is the flap in f or in g: the rulings run from that face's band
@@ -371,7 +375,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
             assert!(
                 forward || backward,
                 "{what}: {}: rulings {:?} are not on the rails of the spec at t = k/{n}",
-                fp.id,
+                fp.id(),
                 lines
                     .iter()
                     .map(|[a, b]| (at(*a), at(*b)))
@@ -394,7 +398,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     cross < exact,
                     "{what}: {} ruling {k} is not parallel to edge {} (|û × ê| = {cross:e})",
-                    fp.id,
+                    fp.id(),
                     e.0
                 );
                 let flat_first = fp.points[lines[0][1] as usize] - fp.points[lines[0][0] as usize];
@@ -403,7 +407,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     cross2 < exact,
                     "{what}: {} flat ruling {k} is not parallel to ruling 0 ({cross2:e})",
-                    fp.id
+                    fp.id()
                 );
             }
             let ruling_set: BTreeSet<(u32, u32)> =
@@ -412,12 +416,12 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     ruling_set.contains(&(*a.min(b), *a.max(b))),
                     "{what}: {} scores {a}-{b}, which is not a ruling",
-                    fp.id
+                    fp.id()
                 );
             }
             for k in 1..=n {
                 let q: Vec<DVec3> = panel.facets[k].iter().map(|&i| at(i)).collect();
-                assert_eq!(q.len(), 4, "{what}: {} strip {k} is not a quad", fp.id);
+                assert_eq!(q.len(), 4, "{what}: {} strip {k} is not a quad", fp.id());
                 let size = diameter(&q, DVec3::distance);
                 for i in 0..4 {
                     let (a, b, c) = (q[(i + 1) % 4], q[(i + 2) % 4], q[(i + 3) % 4]);
@@ -426,7 +430,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                     assert!(
                         off <= exact * size,
                         "{what}: {} strip {k} is not planar: corner {i} is {off:e} mm off the plane of the others (strip size {size} mm)",
-                        fp.id
+                        fp.id()
                     );
                 }
                 strips += 1;
@@ -461,13 +465,13 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     off <= tol,
                     "{what}: {} flap {facet} corner {k} is {off:e} mm off its face's plane",
-                    fp.id
+                    fp.id()
                 );
                 let q2 = to2(q);
                 assert!(
                     inside(&band2, q2) || distance_to_border(&band2, q2) <= tol,
                     "{what}: {} flap {facet} corner {k} leaves the face band",
-                    fp.id
+                    fp.id()
                 );
                 let is_band_corner = band.iter().any(|&b| b.distance(q) <= tol);
                 // Signed distance from the inner line, positive toward the band edge.
@@ -476,13 +480,13 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     side * edge_side.signum() >= -tol,
                     "{what}: {} flap {facet} corner {k} is beyond the inner line",
-                    fp.id
+                    fp.id()
                 );
                 if !is_band_corner {
                     assert!(
                         side.abs() <= tol,
                         "{what}: {} flap {facet} corner {k} is neither a band corner nor on the inner line ({side:e} mm off)",
-                        fp.id
+                        fp.id()
                     );
                 }
             }
@@ -491,7 +495,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 assert!(
                     corners.iter().any(|&q| q.distance(b) <= tol),
                     "{what}: {} flap {facet} misses band corner {b}",
-                    fp.id
+                    fp.id()
                 );
             }
         }
@@ -551,7 +555,7 @@ fn check_holes(
             fp.holes.len(),
             p.output.panels[k].holes.len(),
             "{what}: {}",
-            fp.id
+            fp.id()
         );
         let panel = &p.output.panels[k];
         let last = panel.facets.len() - 1;
@@ -561,18 +565,18 @@ fn check_holes(
                 (hole.connection, hole.facet),
                 (hole3.connection, hole3.facet),
                 "{what}: {} holes out of order",
-                fp.id
+                fp.id()
             );
             assert!(
                 (hole.diameter - d).abs() < 1e-12,
                 "{what}: {} hole diameter {}",
-                fp.id,
+                fp.id(),
                 hole.diameter
             );
             assert!(
                 hole.facet == 0 || hole.facet as usize == last,
                 "{what}: {} hole of connection {} on facet {} (a strip of its {n})",
-                fp.id,
+                fp.id(),
                 hole.connection,
                 hole.facet
             );
@@ -580,14 +584,14 @@ fn check_holes(
             assert!(
                 inside(&facet, hole.center),
                 "{what}: {} hole of connection {} outside its flap",
-                fp.id,
+                fp.id(),
                 hole.connection
             );
             let clear = distance_to_border(&facet, hole.center);
             assert!(
                 clear >= r + d - tol,
                 "{what}: {} hole of connection {} is {clear} mm from its flap's border: radius {r} + one diameter {d} wanted",
-                fp.id,
+                fp.id(),
                 hole.connection
             );
             let frame = fp.frames[hole.facet as usize];
@@ -597,7 +601,7 @@ fn check_holes(
             assert!(
                 point.distance(foot) <= exact,
                 "{what}: {} hole of connection {} unrolls to {point}, not onto its 3D point {} projected on the facet ({foot})",
-                fp.id,
+                fp.id(),
                 hole.connection,
                 hole3.position
             );
@@ -612,7 +616,7 @@ fn check_holes(
                 assert!(
                     gap > d,
                     "{what}: {} holes of connections {} and {} overlap ({gap} mm apart)",
-                    fp.id,
+                    fp.id(),
                     a.connection,
                     b.connection
                 );
@@ -620,7 +624,7 @@ fn check_holes(
                     assert!(
                         gap >= 2.0 * d - tol,
                         "{what}: {} holes of connection {} are {gap} mm apart, less than two diameters",
-                        fp.id,
+                        fp.id(),
                         a.connection
                     );
                 }
@@ -691,8 +695,8 @@ fn check_holes(
             assert!(
                 nearest <= pair_tol,
                 "{what}: connection {c}: hole of {} at {qa} has no partner on {} (nearest {nearest:e} mm, tolerance {pair_tol:e})",
-                p.flat[a].id,
-                p.flat[b].id
+                p.flat[a].id(),
+                p.flat[b].id()
             );
             assert!(
                 matched.insert(j),
@@ -961,7 +965,7 @@ fn check_model(
         for (entry, fp) in list.iter().zip(&p.flat) {
             assert_eq!(
                 entry["id"].as_str(),
-                Some(fp.id.as_str()),
+                Some(fp.id().to_string().as_str()),
                 "{what}: panel order"
             );
             let size = diameter(&fp.outer(), DVec2::distance);
@@ -969,7 +973,7 @@ fn check_model(
             assert!(
                 e <= 1e-9 * size,
                 "{what}: {} developability error {e} mm on a {size} mm panel",
-                fp.id
+                fp.id()
             );
             largest = largest.max(e);
         }
@@ -1041,12 +1045,12 @@ fn open_meshes_give_boundary_edges_a_single_flap() {
             assert!(
                 p.mesh.is_boundary_edge(edge_of(fp)),
                 "{what}: {} has one facet but its edge is interior",
-                fp.id
+                fp.id()
             );
             assert!(
                 fp.scores.is_empty(),
                 "{what}: {} has no bend to score",
-                fp.id
+                fp.id()
             );
         }
         check_developable(&p, &what, 1e-9);
@@ -1221,7 +1225,7 @@ fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
         );
         if name == "icosahedron" {
             for fp in &p.flat {
-                assert_eq!(fp.scores.len(), samples as usize + 1, "{what}: {}", fp.id);
+                assert_eq!(fp.scores.len(), samples as usize + 1, "{what}: {}", fp.id());
             }
         }
     }

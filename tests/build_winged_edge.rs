@@ -73,7 +73,7 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
             by_connection
                 .entry(hole.connection)
                 .or_default()
-                .entry(flat.id.clone())
+                .entry(flat.id().to_string())
                 .or_default()
                 .push(back);
         }

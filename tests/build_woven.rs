@@ -144,7 +144,7 @@ fn the_holes_of_a_lap_joint_meet_in_3d() {
             for hole in &flat.holes {
                 let back = flat.frames[hole.facet as usize].to_3d(hole.center);
                 by_joint.entry(hole.connection).or_default().push((
-                    flat.id.clone(),
+                    flat.id().to_string(),
                     hole.facet,
                     back,
                 ));
@@ -305,7 +305,7 @@ fn flat_ribbons_without_thickness_have_no_turns() {
         assert!(
             panel.facets.iter().all(|f| f.len() == 4),
             "{}: with no thickness every piece is one planar quad",
-            panel.id
+            panel.id()
         );
     }
 }

@@ -120,7 +120,7 @@ pub fn draw_sheet(layout: &Layout, index: usize, panels: &[FlatPanel], sink: &mu
 /// reading along its direction.
 fn draw_labels(panel: &FlatPanel, placement: &Placement, sink: &mut dyn SheetSink) {
     for label in &panel.labels {
-        let strokes = text_strokes(&label.text);
+        let strokes = text_strokes(label.text);
         let h = label.height;
         // Read left to right on the sheet: turning the text half a turn about its box
         // centre keeps it in the same box.

@@ -11,7 +11,7 @@ pub fn assembled_obj(panels: &[Panel]) -> String {
     let mut out = String::from("# unfold: panels as assembled (mm)\n");
     let mut base = 1usize;
     for panel in panels {
-        let _ = writeln!(out, "o {}", panel.id);
+        let _ = writeln!(out, "o {}", panel.id());
         for v in &panel.vertices {
             let _ = writeln!(out, "v {} {} {}", fmt_mm(v.x), fmt_mm(v.y), fmt_mm(v.z));
         }

@@ -10,12 +10,12 @@ use rayon::prelude::*;
 
 use super::{face_band, SchemeOptions};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
-use crate::panel::{Hole, Label, LabelKind, Panel, Source};
+use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Source};
 use crate::plane::{contains, distance_to_border};
 
 /// The id printed for an edge panel.
-pub fn panel_id(e: EdgeId) -> String {
-    format!("E{}", e.0)
+pub fn panel_id(e: EdgeId) -> Name {
+    Name::Edge(e.0)
 }
 
 /// One face's share of the edge panels, in 3D.
@@ -231,7 +231,7 @@ fn edge_panel(
         vertices.push(p);
         (vertices.len() - 1) as u32
     };
-    let mut facets: Vec<Vec<u32>> = Vec::new();
+    let mut facets = Loops::new();
     let mut holes = Vec::new();
     let mut labels = Vec::new();
 
@@ -269,7 +269,7 @@ fn edge_panel(
                         start: u32,
                         end: u32,
                         vertices: &mut Vec<DVec3>,
-                        facets: &mut Vec<Vec<u32>>| {
+                        facets: &mut Loops| {
         let mut flap = vec![start, end];
         for &p in &part.flap_rest[edge] {
             flap.push(push(p, vertices));
@@ -342,14 +342,7 @@ fn edge_panel(
         );
     }
 
-    Panel {
-        id: panel_id(e),
-        source: Source::Edge(e.0),
-        vertices,
-        facets,
-        holes,
-        labels,
-    }
+    Panel::new(Source::Edge(e.0), vertices, facets, holes, labels)
 }
 
 /// Labels on a flap: the partner panel's id toward each of its two corners, the vertex
@@ -389,7 +382,7 @@ fn flap_labels(
     }
     for (_, c, vertex) in ends {
         labels.push(Label {
-            text: format!("V{}", vertex.0),
+            text: Name::Vertex(vertex.0),
             anchor: part.corner_label[c],
             direction: along,
             height: options.label_height,
@@ -400,7 +393,7 @@ fn flap_labels(
         });
     }
     labels.push(Label {
-        text: format!("F{}", face.0),
+        text: Name::Face(face.0),
         anchor: middle,
         direction: along,
         height: options.label_height,

@@ -13,7 +13,7 @@ use rayon::prelude::*;
 
 use super::{face_band, SchemeOptions, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
-use crate::panel::{Hole, Label, LabelKind, Panel, Source};
+use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
@@ -35,8 +35,8 @@ struct Tab {
 }
 
 /// The id printed for a face panel.
-pub fn panel_id(f: FaceId) -> String {
-    format!("F{}", f.0)
+pub fn panel_id(f: FaceId) -> Name {
+    Name::Face(f.0)
 }
 
 /// Builds the face panels of a mesh whose faces are planar and star-shaped from their
@@ -151,8 +151,11 @@ fn face_panel(
         }
         pending_tabs.push((tab, a_base, b_base));
     }
-    let mut facets = vec![band_facet];
-    facets.extend(extra_facets);
+    let mut facets = Loops::new();
+    facets.push(band_facet);
+    for facet in extra_facets {
+        facets.push(facet);
+    }
     for (tab, a_base, b_base) in pending_tabs {
         let mut facet = vec![b_base, a_base];
         for &p in &tab.top {
@@ -224,14 +227,7 @@ fn face_panel(
         });
     }
 
-    Panel {
-        id: panel_id(f),
-        source: Source::Face(f.0),
-        vertices,
-        facets,
-        holes,
-        labels,
-    }
+    Panel::new(Source::Face(f.0), vertices, facets, holes, labels)
 }
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or

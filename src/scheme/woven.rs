@@ -31,7 +31,7 @@ use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
 use crate::nest::shelf::{fits_rotated, smallest_box};
-use crate::panel::{FacetFrame, Hole, Label, LabelKind, Panel, Source};
+use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Source};
 use crate::plane::{
     clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, segment_distance,
 };
@@ -179,13 +179,16 @@ pub struct CycleSummary {
 }
 
 /// The printed id of a cycle.
-pub fn cycle_id(cycle: u32) -> String {
-    format!("C{}", cycle + 1)
+pub fn cycle_id(cycle: u32) -> Name {
+    Name::Cycle(cycle + 1)
 }
 
 /// The printed id of a segment (both 1-based).
-pub fn segment_id(cycle: u32, segment: usize) -> String {
-    format!("C{}.{}", cycle + 1, segment + 1)
+pub fn segment_id(cycle: u32, segment: usize) -> Name {
+    Name::Segment {
+        cycle: cycle + 1,
+        segment: segment as u32 + 1,
+    }
 }
 
 /// The face bands' geometry the strands are cut from.
@@ -736,7 +739,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
                     .flat_map(|l| r.lines[l % ring])
                     .collect();
                 SchemeError::TooLarge {
-                    cycle: cycle_id(r.cycle),
+                    cycle: cycle_id(r.cycle).to_string(),
                     size: crate::mesh::geometry::diameter(&points),
                 }
             })
@@ -814,7 +817,7 @@ fn segment_panel(
     let vertices: Vec<DVec3> = (0..=chain.len())
         .flat_map(|j| ribbon.lines[(first + j) % ring])
         .collect();
-    let mut facets = Vec::new();
+    let mut facets = Loops::new();
     let mut facet_start = Vec::new();
     for (j, &k) in chain.iter().enumerate() {
         facet_start.push(facets.len());
@@ -822,8 +825,7 @@ fn segment_panel(
             facets.push(
                 facet
                     .iter()
-                    .map(|c| (2 * (j + c.line as usize) + c.end as usize) as u32)
-                    .collect::<Vec<u32>>(),
+                    .map(|c| (2 * (j + c.line as usize) + c.end as usize) as u32),
             );
         }
     }
@@ -879,7 +881,7 @@ fn segment_panel(
                 k,
                 0,
                 facet_start[j],
-                id.clone(),
+                id,
                 LabelKind::Panel,
                 options,
             ));
@@ -895,9 +897,8 @@ fn segment_panel(
         ));
     }
     (
-        Panel {
-            id,
-            source: Source::Cycle {
+        Panel::new(
+            Source::Cycle {
                 cycle: ribbon.cycle + 1,
                 segment: segment as u32 + 1,
             },
@@ -905,7 +906,7 @@ fn segment_panel(
             facets,
             holes,
             labels,
-        },
+        ),
         short,
     )
 }
@@ -931,7 +932,7 @@ fn strand_label(
     k: usize,
     local: usize,
     facet: usize,
-    text: String,
+    text: Name,
     kind: LabelKind,
     options: &SchemeOptions,
 ) -> Label {

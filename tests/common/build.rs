@@ -523,7 +523,7 @@ pub fn pipeline(job: &Job) -> Pipeline {
     let flat = output
         .panels
         .iter()
-        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id)))
+        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
         .collect();
     Pipeline {
         mesh,
