@@ -388,3 +388,57 @@ impl FlatPanel {
         best.sqrt()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loops_keep_each_loop_apart_and_in_order() {
+        let mut loops = Loops::new();
+        assert!(loops.is_empty() && loops.first().is_none());
+        loops.push([0, 1, 2]);
+        loops.push(Vec::new());
+        loops.push([3, 4, 5, 6]);
+        assert_eq!(loops.len(), 3);
+        assert_eq!(loops.index_count(), 7);
+        assert_eq!(&loops[0], &[0, 1, 2]);
+        assert_eq!(&loops[1], &[] as &[u32]);
+        assert_eq!(loops.get(2), Some(&[3, 4, 5, 6][..]));
+        assert_eq!(loops.get(3), None);
+        let collected: Vec<Vec<u32>> = loops.iter().map(<[u32]>::to_vec).collect();
+        assert_eq!(collected, [vec![0, 1, 2], vec![], vec![3, 4, 5, 6]]);
+        assert_eq!(loops.iter().next_back(), Some(&[3, 4, 5, 6][..]));
+        let rebuilt: Loops = collected.into_iter().collect();
+        assert_eq!(rebuilt, loops);
+        assert_eq!((&loops).into_iter().count(), 3);
+    }
+
+    #[test]
+    fn names_print_as_the_ids_users_read() {
+        assert_eq!(Name::Face(12).to_string(), "F12");
+        assert_eq!(Name::Edge(123).to_string(), "E123");
+        assert_eq!(Name::Vertex(7).to_string(), "V7");
+        assert_eq!(Name::Cycle(3).to_string(), "C3");
+        assert_eq!(
+            Name::Segment {
+                cycle: 3,
+                segment: 2
+            }
+            .to_string(),
+            "C3.2"
+        );
+        let source = Source::Cycle {
+            cycle: 3,
+            segment: 2,
+        };
+        assert_eq!(
+            source.name(),
+            Name::Segment {
+                cycle: 3,
+                segment: 2
+            }
+        );
+        assert_eq!(Source::Edge(5).name().to_string(), "E5");
+    }
+}

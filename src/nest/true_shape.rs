@@ -86,6 +86,8 @@ struct Part {
     area: f64,
     /// Allowed orientations with the collision shape's bounds at each (no translation).
     orientations: Vec<Orientation>,
+    /// Which of them lie square to the part's axis (quarter turns from it, either side).
+    square: Vec<usize>,
     /// Discs inside the collision shape that measure its overlap with others.
     discs: Vec<Circle>,
 }
@@ -302,6 +304,7 @@ fn prepare_part(
     // axes pack in rows.
     let axis = crate::plane::smallest_box_rotation(outline);
     let mut orientations = Vec::new();
+    let mut square = Vec::new();
     for mirrored in [false, true] {
         if mirrored && !options.mirror {
             continue;
@@ -315,6 +318,9 @@ fn prepare_part(
             let fits = bb.x_max - bb.x_min <= sheet_bounds.x_max - sheet_bounds.x_min
                 && bb.y_max - bb.y_min <= sheet_bounds.y_max - sheet_bounds.y_min;
             if fits {
+                if (4 * k).is_multiple_of(steps) {
+                    square.push(orientations.len());
+                }
                 orientations.push(Orientation {
                     rotation,
                     mirrored,
@@ -334,6 +340,7 @@ fn prepare_part(
         center,
         area: crate::plane::area(outline),
         orientations,
+        square,
     })
 }
 
@@ -642,12 +649,11 @@ impl<'a> Nester<'a> {
             found.truncate(REFINED);
         };
         for _ in 0..samples {
-            let n = p.orientations.len();
-            // Half the samples lie square to the part's axis (every quarter turn).
-            let o = if n.is_multiple_of(4) && self.rng.unit() < 0.5 {
-                self.rng.below(4) * (n / 4)
+            // Half the samples lie square to the part's axis.
+            let o = if !p.square.is_empty() && self.rng.unit() < 0.5 {
+                p.square[self.rng.below(p.square.len())]
             } else {
-                self.rng.below(n)
+                self.rng.below(p.orientations.len())
             };
             let rng = &mut self.rng;
             let Some((px, py)) = self.sheets[s].grid.free_point(|| rng.unit(), 32) else {
@@ -805,5 +811,74 @@ impl<'a> Nester<'a> {
         let areas: Vec<f64> = self.parts.iter().map(|p| p.area).collect();
         layout.fullest_first(&areas);
         layout
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rotation of each square orientation, relative to the first, in quarter turns
+    /// (and whether it is mirrored).
+    fn square_turns(
+        outline: &[DVec2],
+        sheet: SheetSpec,
+        options: &NestOptions,
+    ) -> Vec<(i64, bool)> {
+        let (parts, _) = prepare(&[outline.to_vec()], sheet, options).expect("fits");
+        let part = &parts[0];
+        let first = part.orientations[0].rotation as f64;
+        part.square
+            .iter()
+            .map(|&o| {
+                let or = part.orientations[o];
+                let turn = (or.rotation as f64 - first).rem_euclid(std::f64::consts::TAU);
+                let quarters = turn / std::f64::consts::FRAC_PI_2;
+                assert!((quarters - quarters.round()).abs() < 1e-5, "{quarters}");
+                ((quarters.round() as i64) % 4, or.mirrored)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn square_orientations_are_the_quarter_turns_of_each_side() {
+        let options = |rotations, mirror| NestOptions {
+            rotations,
+            mirror,
+            effort: 1,
+            seed: 0,
+            time_limit: None,
+        };
+        let sheet = SheetSpec {
+            width: 600.0,
+            height: 300.0,
+            margin: 5.0,
+            spacing: 2.0,
+        };
+        let bar: Vec<DVec2> = [(0.0, 0.0), (40.0, 0.0), (40.0, 10.0), (0.0, 10.0)]
+            .map(|(x, y)| DVec2::new(x, y))
+            .to_vec();
+        let all = |mirrored| (0..4).map(move |q| (q, mirrored));
+        assert_eq!(
+            square_turns(&bar, sheet, &options(32, false)),
+            all(false).collect::<Vec<_>>()
+        );
+        // Mirrored orientations follow the plain ones: their quarter turns too, not the
+        // 0 and 180 degrees of each side that every n/4-th index would give.
+        let both: Vec<_> = all(false).chain(all(true)).collect();
+        assert_eq!(square_turns(&bar, sheet, &options(32, true)), both);
+        // Six steps: only 0 and 180 degrees are quarter turns.
+        assert_eq!(
+            square_turns(&bar, sheet, &options(6, false)),
+            [(0, false), (2, false)]
+        );
+        // A bar longer than the sheet is tall (440 mm on 300): upright and steep
+        // orientations are dropped, and
+        // the square ones are still the lying ones.
+        let long: Vec<DVec2> = bar.iter().map(|p| DVec2::new(p.x * 11.0, p.y)).collect();
+        assert_eq!(
+            square_turns(&long, sheet, &options(32, false)),
+            [(0, false), (2, false)]
+        );
     }
 }
