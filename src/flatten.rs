@@ -266,3 +266,72 @@ fn outline_loops(edges: &[EdgeUse], points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
     loops.swap(0, outer);
     Some(loops)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::panel::{Hole, Source};
+    use crate::plane::signed_area;
+
+    /// A unit square facet and a second square folded up by 90° along x = 1, plus a
+    /// hole on the folded facet.
+    fn folded_strip() -> Panel {
+        Panel::new(
+            Source::Face(0),
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(1.0, 0.0, 1.0),
+                DVec3::new(1.0, 1.0, 1.0),
+            ],
+            [vec![0, 1, 2, 3], vec![1, 4, 5, 2]].into_iter().collect(),
+            vec![Hole {
+                position: DVec3::new(1.0, 0.5, 0.5),
+                diameter: 0.1,
+                connection: 7,
+                facet: 1,
+            }],
+            vec![],
+        )
+    }
+
+    #[test]
+    fn folded_strip_unrolls_flat_and_keeps_lengths() {
+        let flat = flatten(&folded_strip()).unwrap();
+        assert!(flat.developability_error < 1e-12);
+        assert!((flat.area - 2.0).abs() < 1e-12);
+        // Unrolled, the fold at x = 1 opens to a 2 x 1 rectangle.
+        assert!(flat.points[4].distance(DVec2::new(2.0, 0.0)) < 1e-12);
+        assert!(flat.points[5].distance(DVec2::new(2.0, 1.0)) < 1e-12);
+        assert_eq!(flat.scores, vec![[1, 2]]);
+        assert_eq!(flat.outline.len(), 1);
+        assert_eq!(flat.outline[0].len(), 6);
+        assert!(signed_area(&flat.outer()) > 0.0, "outside face up");
+        // The hole maps into the plane and back to the same 3D point.
+        let hole = &flat.holes[0];
+        assert!(hole.center.distance(DVec2::new(1.5, 0.5)) < 1e-12);
+        let back = flat.frames[1].to_3d(hole.center);
+        assert!(back.distance(DVec3::new(1.0, 0.5, 0.5)) < 1e-12);
+    }
+
+    #[test]
+    fn coplanar_facets_are_not_scored() {
+        let mut panel = folded_strip();
+        panel.vertices[4] = DVec3::new(2.0, 0.0, 0.0);
+        panel.vertices[5] = DVec3::new(2.0, 1.0, 0.0);
+        panel.holes.clear();
+        let flat = flatten(&panel).unwrap();
+        assert!(flat.scores.is_empty());
+    }
+
+    #[test]
+    fn disconnected_facets_are_an_error() {
+        let mut panel = folded_strip();
+        panel.facets = [vec![0, 1, 2], vec![4, 5, 3]].into_iter().collect();
+        panel.vertices[3] = DVec3::new(5.0, 5.0, 0.0);
+        panel.holes.clear();
+        assert!(flatten(&panel).is_err());
+    }
+}

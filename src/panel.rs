@@ -165,8 +165,11 @@ impl Loops {
     }
 
     /// The loops in order.
-    pub fn iter(&self) -> impl ExactSizeIterator<Item = &[u32]> + DoubleEndedIterator + '_ {
-        (0..self.len()).map(move |k| &self[k])
+    pub fn iter(&self) -> LoopsIter<'_> {
+        LoopsIter {
+            loops: self,
+            range: 0..self.len(),
+        }
     }
 
     /// Indices in all loops together.
@@ -189,11 +192,36 @@ impl std::ops::Index<usize> for Loops {
     }
 }
 
+/// The loops of a [`Loops`], in order.
+#[derive(Clone, Debug)]
+pub struct LoopsIter<'a> {
+    loops: &'a Loops,
+    range: std::ops::Range<usize>,
+}
+
+impl<'a> Iterator for LoopsIter<'a> {
+    type Item = &'a [u32];
+    fn next(&mut self) -> Option<&'a [u32]> {
+        self.range.next().map(|k| &self.loops[k])
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.range.size_hint()
+    }
+}
+
+impl DoubleEndedIterator for LoopsIter<'_> {
+    fn next_back(&mut self) -> Option<Self::Item> {
+        self.range.next_back().map(|k| &self.loops[k])
+    }
+}
+
+impl ExactSizeIterator for LoopsIter<'_> {}
+
 impl<'a> IntoIterator for &'a Loops {
     type Item = &'a [u32];
-    type IntoIter = Box<dyn Iterator<Item = &'a [u32]> + 'a>;
-    fn into_iter(self) -> Self::IntoIter {
-        Box::new(self.iter())
+    type IntoIter = LoopsIter<'a>;
+    fn into_iter(self) -> LoopsIter<'a> {
+        self.iter()
     }
 }
 
