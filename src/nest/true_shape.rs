@@ -14,8 +14,11 @@
 //!
 //! Every random choice comes from one generator seeded by `seed`, and the effort is a
 //! number of samples and rounds, so the result depends on the input and the options
-//! only (the nester runs on one thread). `time_limit` is an optional cap on the
-//! improvement, and the only source of run-to-run differences when it is hit.
+//! only. The sampled poses of a search are drawn in order and then tested in
+//! parallel against a sheet that does not change meanwhile, and compared in order,
+//! so the thread count changes the speed, never the result. `time_limit` is an
+//! optional cap on the improvement, and the only source of run-to-run differences
+//! when it is hit.
 
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -113,6 +116,9 @@ struct Candidate {
 
 /// How many of the best samples get the local search.
 const REFINED: usize = 3;
+
+/// Fewest samples one parallel task tests (fewer would cost more to hand out).
+const SAMPLES_PER_TASK: usize = 16;
 
 /// Smallest step of the local search (mm).
 const MIN_STEP: f32 = 0.05;
@@ -636,18 +642,18 @@ impl<'a> Nester<'a> {
 
     /// The best free pose of `part` on sheet `s`: `samples` random positions drawn
     /// from free cells, the best few refined by a local search.
+    ///
+    /// The positions are drawn in order from the one generator, then tested in
+    /// parallel against the sheet (which does not change meanwhile), and the refined
+    /// candidates are compared in order: the result and the checks counted do not
+    /// depend on the thread count.
     fn search(&mut self, s: usize, part: usize, samples: usize) -> Option<Candidate> {
         let parts = self.parts;
         let p = &parts[part];
         if p.item.shape_cd().area() > 1.05 * self.sheets[s].grid.free_area() {
             return None;
         }
-        let mut found: Vec<(f32, Candidate)> = Vec::new();
-        let consider = |found: &mut Vec<(f32, Candidate)>, score: f32, c: Candidate| {
-            found.push((score, c));
-            found.sort_by(|a, b| a.0.total_cmp(&b.0));
-            found.truncate(REFINED);
-        };
+        let mut drawn: Vec<Candidate> = Vec::with_capacity(samples);
         for _ in 0..samples {
             // Half the samples lie square to the part's axis.
             let o = if !p.square.is_empty() && self.rng.unit() < 0.5 {
@@ -659,28 +665,46 @@ impl<'a> Nester<'a> {
             let Some((px, py)) = self.sheets[s].grid.free_point(|| rng.unit(), 32) else {
                 continue;
             };
-            let c = self.clamp(
+            drawn.push(self.clamp(
                 part,
                 o,
                 px - p.orientations[o].poi.0,
                 py - p.orientations[o].poi.1,
-            );
-            if let Some(score) = self.score_if_free(s, part, c) {
-                consider(&mut found, score, c);
-            }
+            ));
         }
         // An empty sheet: also its bottom-left corner in each orientation.
         if self.sheets[s].parts.is_empty() {
             for o in 0..p.orientations.len() {
-                let c = self.clamp(part, o, f32::NEG_INFINITY, f32::NEG_INFINITY);
-                if let Some(score) = self.score_if_free(s, part, c) {
-                    consider(&mut found, score, c);
-                }
+                drawn.push(self.clamp(part, o, f32::NEG_INFINITY, f32::NEG_INFINITY));
             }
         }
+        self.checks += drawn.len() as u64;
+        let this = &*self;
+        let scores: Vec<Option<f32>> = drawn
+            .par_iter()
+            .with_min_len(SAMPLES_PER_TASK)
+            .map_init(
+                || this.scratch_for(part),
+                |scratch, &c| this.score_if_free(s, part, c, scratch),
+            )
+            .collect();
+        // The best few, earliest first on ties.
+        let mut found: Vec<(f32, Candidate)> = Vec::with_capacity(REFINED + 1);
+        for (&c, score) in drawn.iter().zip(scores) {
+            if let Some(score) = score {
+                found.push((score, c));
+                found.sort_by(|a, b| a.0.total_cmp(&b.0));
+                found.truncate(REFINED);
+            }
+        }
+        let refined: Vec<(f32, Candidate, u64)> = found
+            .par_iter()
+            .with_min_len(1)
+            .map(|&(score, c)| this.refine(s, part, score, c, &mut this.scratch_for(part)))
+            .collect();
         let mut best: Option<(f32, Candidate)> = None;
-        for (score, c) in found {
-            let (score, c) = self.refine(s, part, score, c);
+        for (score, c, checks) in refined {
+            self.checks += checks;
             if best.is_none_or(|(b, _)| score < b) {
                 best = Some((score, c));
             }
@@ -709,14 +733,15 @@ impl<'a> Nester<'a> {
 
     /// Greedy local search from a free candidate: moves in eight directions and turns
     /// by one rotation step, keeping any change that lowers the score, halving the
-    /// step when none does.
+    /// step when none does. Returns the score, the pose and the checks made.
     fn refine(
-        &mut self,
+        &self,
         s: usize,
         part: usize,
         mut score: f32,
         mut c: Candidate,
-    ) -> (f32, Candidate) {
+        scratch: &mut SPolygon,
+    ) -> (f32, Candidate, u64) {
         const D: f32 = std::f32::consts::FRAC_1_SQRT_2;
         const DIRECTIONS: [(f32, f32); 8] = [
             (0.0, -1.0),
@@ -730,11 +755,13 @@ impl<'a> Nester<'a> {
         ];
         let n_orient = self.parts[part].orientations.len();
         let mut step = 0.25 * self.parts[part].item.shape_cd().diameter();
+        let mut checks = 0;
         while step > MIN_STEP {
             let mut improved = false;
             for (dx, dy) in DIRECTIONS {
                 let next = self.clamp(part, c.orientation, c.x + dx * step, c.y + dy * step);
-                if let Some(v) = self.score_if_free(s, part, next) {
+                checks += 1;
+                if let Some(v) = self.score_if_free(s, part, next, scratch) {
                     if v < score - 1e-4 {
                         (score, c) = (v, next);
                         improved = true;
@@ -745,7 +772,8 @@ impl<'a> Nester<'a> {
                 for turn in [1, n_orient - 1] {
                     let o = (c.orientation + turn) % n_orient;
                     let next = self.clamp(part, o, c.x, c.y);
-                    if let Some(v) = self.score_if_free(s, part, next) {
+                    checks += 1;
+                    if let Some(v) = self.score_if_free(s, part, next, scratch) {
                         if v < score - 1e-4 {
                             (score, c) = (v, next);
                             improved = true;
@@ -757,12 +785,24 @@ impl<'a> Nester<'a> {
                 step *= 0.5;
             }
         }
-        (score, c)
+        (score, c, checks)
     }
 
-    /// The bottom-left score of a pose, or `None` when it collides.
-    fn score_if_free(&mut self, s: usize, part: usize, c: Candidate) -> Option<f32> {
-        self.checks += 1;
+    /// A buffer for [`Self::score_if_free`]: `transform_from` needs one cloned from
+    /// the same part (it keeps the buffer's surrogate layout and cached facts).
+    fn scratch_for(&self, part: usize) -> SPolygon {
+        self.parts[part].item.shape_cd().as_ref().clone()
+    }
+
+    /// The bottom-left score of a pose, or `None` when it collides. `scratch` must
+    /// come from [`Self::scratch_for`] of the same part; the caller counts the check.
+    fn score_if_free(
+        &self,
+        s: usize,
+        part: usize,
+        c: Candidate,
+        scratch: &mut SPolygon,
+    ) -> Option<f32> {
         let item = &self.parts[part].item;
         let cde = self.sheets[s].layout.cde();
         let transform = self.pose(part, c).compose();
@@ -770,17 +810,11 @@ impl<'a> Nester<'a> {
         if cde.detect_surrogate_collision(shape.surrogate(), &transform, &NoFilter) {
             return None;
         }
-        // transform_from needs a buffer cloned from the same part: it keeps the
-        // buffer's surrogate layout and cached facts.
-        if self.scratch_part != part {
-            self.scratch = shape.as_ref().clone();
-            self.scratch_part = part;
-        }
-        self.scratch.transform_from(shape, &transform);
-        if cde.detect_poly_collision(&self.scratch, &NoFilter) {
+        scratch.transform_from(shape, &transform);
+        if cde.detect_poly_collision(scratch, &NoFilter) {
             return None;
         }
-        let bb = self.scratch.bbox();
+        let bb = scratch.bbox();
         Some(bb.y_max + LEFT_WEIGHT * bb.x_max)
     }
 
