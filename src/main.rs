@@ -62,7 +62,9 @@ enum Command {
         #[arg(long)]
         json: bool,
 
-        /// Read options from a TOML file; options on the command line win.
+        /// Read options from a TOML file (a build's config file: its model options and
+        /// non-planar policy are used, its other keys ignored); options on the command
+        /// line win.
         #[arg(long, value_name = "FILE")]
         config: Option<PathBuf>,
 
@@ -128,9 +130,15 @@ fn run(cli: Cli) -> Result<()> {
             nonplanar,
             options,
         }) => {
-            let options = match config {
-                Some(path) => options.or(load_config::<ModelOptions>(&path)?),
-                None => options,
+            // The build's own config file works here: its model options and non-planar
+            // policy are what preparation uses; its other keys (sheet, scheme, ...) do
+            // not change preparation and are read but not used.
+            let (options, nonplanar) = match config {
+                Some(path) => {
+                    let file = load_config::<BuildOptions>(&path)?;
+                    (options.or(file.model), nonplanar.or(file.nonplanar))
+                }
+                None => (options, nonplanar),
             };
             let settings = options.resolve()?;
             let nonplanar = nonplanar.unwrap_or(NonPlanar::Triangulate);

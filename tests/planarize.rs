@@ -141,6 +141,33 @@ fn inspect_previews_the_planarization_the_build_does() {
 }
 
 #[test]
+fn inspect_reads_the_builds_config_file() {
+    let Some(shared) = shared_models("planarize") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let path = shared.join("suzanne.obj");
+    // A build's config: keys inspect does not use (scheme, sheet) are accepted.
+    let config = tmp.path().join("build.toml");
+    std::fs::write(
+        &config,
+        "scheme = \"quad-edge\"\nsheet = \"18x24in\"\nsize = \"4ft\"\nnonplanar = \"planarize\"\n",
+    )
+    .unwrap();
+    let config = config.to_str().unwrap();
+    let from_file = inspect_json(&path, &["--config", config]);
+    let from_options = inspect_json(&path, &["--size", "4ft", "--nonplanar", "planarize"]);
+    assert_eq!(from_file["nonplanar"], "planarize");
+    assert!(from_file["planarized"]["non_planar_before"].as_u64() > Some(0));
+    assert_eq!(from_file["planarized"], from_options["planarized"]);
+    assert_eq!(from_file["preparation"], from_options["preparation"]);
+    // The command line wins over the file.
+    let overridden = inspect_json(&path, &["--config", config, "--nonplanar", "triangulate"]);
+    assert_eq!(overridden["nonplanar"], "triangulate");
+    assert!(overridden["planarized"].is_null());
+}
+
+#[test]
 fn a_planar_mesh_does_not_move() {
     let tmp = TempDir::new().unwrap();
     for name in ["hexahedron", "torus-8x6", "genus2", "dodecahedron"] {
