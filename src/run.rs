@@ -86,10 +86,11 @@ pub fn scheme_mesh(
     raw: &crate::mesh::RawModel,
     mut mesh: crate::mesh::Mesh,
 ) -> Result<SchemeMesh> {
-    let geometry = mesh.geometry_facts(job.model.planarity_tol);
+    // Only the size here: the planarity of every face is measured once, by
+    // `faces_to_split` below, on the scaled mesh.
     let mm_per_unit = job
         .model
-        .checked_mm_per_unit(&job.model_path, geometry.longest_side())?;
+        .checked_mm_per_unit(&job.model_path, mesh.longest_side())?;
     mesh.scale(mm_per_unit);
     let planarized = if job.nonplanar == NonPlanar::Planarize {
         Some(planarize_faces(

@@ -77,13 +77,22 @@ pub struct GeometryFacts {
 impl GeometryFacts {
     /// The longest side of the bounding box.
     pub fn longest_side(&self) -> f64 {
-        (0..3)
-            .map(|k| self.bbox_max[k] - self.bbox_min[k])
-            .fold(0.0, f64::max)
+        longest_side(self.bbox_min, self.bbox_max)
     }
 }
 
+fn longest_side(lo: [f64; 3], hi: [f64; 3]) -> f64 {
+    (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max)
+}
+
 impl Mesh {
+    /// The longest side of the bounding box of the positions (what `--size` sets),
+    /// without the per-face facts of [`Mesh::geometry_facts`].
+    pub fn longest_side(&self) -> f64 {
+        let (lo, hi) = super::geometry::bounding_box(self.positions.iter().copied());
+        longest_side(lo.to_array(), hi.to_array())
+    }
+
     /// The connected component of every face (numbered from 0 in order of each
     /// component's lowest face) and the number of components.
     pub fn face_components(&self) -> (Vec<u32>, usize) {
