@@ -142,6 +142,8 @@ struct Nester<'a> {
     bounds: Rect,
     rng: SplitMix64,
     samples: usize,
+    /// The separator's buffer for a posed shape (the free-pose search makes its own
+    /// per thread with [`Nester::scratch_for`]).
     scratch: SPolygon,
     /// The part `scratch` was cloned from (its surrogate and cached facts match).
     scratch_part: usize,
