@@ -115,11 +115,7 @@ fn nesting_and_export(c: &mut Criterion) {
         let flat = flat_panels(&job, &scheme_mesh(&job));
         // The largest 400 panels: a job of a few sheets, so a sample takes seconds.
         let mut by_area: Vec<&FlatPanel> = flat.iter().collect();
-        by_area.sort_by(|a, b| {
-            b.area
-                .total_cmp(&a.area)
-                .then(a.id().to_string().cmp(&b.id().to_string()))
-        });
+        by_area.sort_by(|a, b| b.area.total_cmp(&a.area).then(a.id().cmp(&b.id())));
         by_area.truncate(400);
         let outlines: Vec<Vec<DVec2>> = by_area.iter().map(|p| p.outer()).collect();
         let areas: Vec<f64> = by_area.iter().map(|p| p.area).collect();

@@ -35,6 +35,11 @@ fn render(text: &str) -> Vec<vector_text::Point> {
     render_text(text, VectorFont::HersheyFont(HersheyFont::Romans))
 }
 
+/// The characters the font draws (printable ASCII); others are skipped.
+fn is_printable(c: &char) -> bool {
+    (' '..='~').contains(c)
+}
+
 /// The metrics of every printable ASCII character, measured once from the renderer
 /// itself: the extent from the character alone, the advance from where a following
 /// `I` lands.
@@ -89,7 +94,7 @@ struct WidthMeter {
 
 impl std::fmt::Write for WidthMeter {
     fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        for c in s.chars().filter(|c| (' '..='~').contains(c)) {
+        for c in s.chars().filter(is_printable) {
             let glyph = self.table[c as usize - ' ' as usize];
             if let Some((a, b)) = glyph.extent {
                 self.lo = self.lo.min(self.pen + a);
@@ -103,11 +108,7 @@ impl std::fmt::Write for WidthMeter {
 
 /// The strokes of an ASCII text. Characters outside printable ASCII are skipped.
 pub fn text_strokes(text: impl std::fmt::Display) -> TextStrokes {
-    let ascii: String = text
-        .to_string()
-        .chars()
-        .filter(|c| (' '..='~').contains(c))
-        .collect();
+    let ascii: String = text.to_string().chars().filter(is_printable).collect();
     let points = render(&ascii);
     let min_x = points.iter().map(|p| p.x).min().unwrap_or(0) as f64;
     let mut polylines: Vec<Vec<DVec2>> = Vec::new();

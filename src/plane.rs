@@ -51,6 +51,14 @@ pub fn loop_signed_area(points: &[DVec2], indices: &[u32]) -> f64 {
         .sum::<f64>()
 }
 
+/// Axis-aligned bounds of points: (lower corner, upper corner).
+pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
+    points.into_iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p), hi.max(p)),
+    )
+}
+
 /// The polygon's corners in counter-clockwise order (reversed when clockwise).
 pub fn counter_clockwise(poly: &[DVec2]) -> Vec<DVec2> {
     if signed_area(poly) < 0.0 {
@@ -259,12 +267,7 @@ pub fn smallest_box_rotation(points: &[DVec2]) -> f64 {
         // Turning by -angle(edge) lays the edge along +x.
         let mut rotation = -edge.y.atan2(edge.x);
         let turn = DVec2::from_angle(rotation);
-        let (mut lo, mut hi) = (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY));
-        for &p in &hull {
-            let q = turn.rotate(p);
-            lo = lo.min(q);
-            hi = hi.max(q);
-        }
+        let (lo, hi) = bounds(hull.iter().map(|&p| turn.rotate(p)));
         let size = hi - lo;
         if size.y > size.x {
             rotation += std::f64::consts::FRAC_PI_2;
@@ -384,11 +387,7 @@ mod offset_tests {
             .map(|&(x, y)| turn.rotate(DVec2::new(x, y) + DVec2::new(3.0, -7.0)))
             .collect();
         let back = DVec2::from_angle(smallest_box_rotation(&rect));
-        let turned: Vec<DVec2> = rect.iter().map(|&p| back.rotate(p)).collect();
-        let (lo, hi) = turned.iter().fold(
-            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &p| (lo.min(p), hi.max(p)),
-        );
+        let (lo, hi) = bounds(rect.iter().map(|&p| back.rotate(p)));
         assert!(((hi - lo) - DVec2::new(40.0, 10.0)).abs().max_element() < 1e-9);
         // A right triangle's smallest box has its legs along the axes.
         let triangle = [DVec2::ZERO, DVec2::new(30.0, 0.0), DVec2::new(0.0, 20.0)];

@@ -78,9 +78,7 @@ impl<'a> TriangleGrid<'a> {
             cell = longest.max(1e-12);
         }
         let dims = [size.x, size.y, size.z].map(|s| ((s / cell).floor() as usize + 1).min(257));
-        let index = |p: DVec3, k: usize| -> usize {
-            (((p[k] - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1)
-        };
+        let index = |p: DVec3, k: usize| cell_index(p, k, lo, cell, dims);
         let cells = dims[0] * dims[1] * dims[2];
         let mut counts = vec![0u32; cells + 1];
         let mut ranges = Vec::with_capacity(triangles.len());
@@ -127,9 +125,7 @@ impl<'a> TriangleGrid<'a> {
         if self.triangles.is_empty() {
             return f64::INFINITY;
         }
-        let home = [0, 1, 2].map(|k| {
-            (((p[k] - self.lo[k]) / self.cell).floor().max(0.0) as usize).min(self.dims[k] - 1)
-        });
+        let home = [0, 1, 2].map(|k| cell_index(p, k, self.lo, self.cell, self.dims));
         let mut best = f64::INFINITY;
         let max_ring = self.dims.iter().copied().max().unwrap_or(1);
         for ring in 0..=max_ring {
@@ -173,6 +169,12 @@ impl<'a> TriangleGrid<'a> {
     }
 }
 
+/// The cell of `p` along axis `k` of a grid from `lo` with cubic cells of side `cell`
+/// (points outside go to the nearest border cell).
+fn cell_index(p: DVec3, k: usize, lo: DVec3, cell: f64, dims: [usize; 3]) -> usize {
+    (((p[k] - lo[k]) / cell).floor().max(0.0) as usize).min(dims[k] - 1)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -189,6 +191,7 @@ mod tests {
         assert_eq!(near(DVec3::new(2.0, -0.5, 0.0)), b);
         assert_eq!(near(DVec3::new(-0.5, 3.0, 1.0)), c);
         assert_eq!(near(DVec3::new(0.5, -2.0, 0.0)), DVec3::new(0.5, 0.0, 0.0));
+        assert_eq!(near(DVec3::new(-2.0, 0.5, 1.0)), DVec3::new(0.0, 0.5, 0.0));
         assert!(near(DVec3::new(1.0, 1.0, 0.0)).distance(DVec3::new(0.5, 0.5, 0.0)) < 1e-12);
     }
 
@@ -206,13 +209,8 @@ mod tests {
             }
         }
         let grid = TriangleGrid::new(&triangles);
-        let mut seed = 7u64;
-        let mut unit = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::nest::rng::SplitMix64::new(7);
+        let mut unit = || rng.unit();
         for _ in 0..300 {
             let p = DVec3::new(unit() * 14.0 - 2.0, unit() * 14.0 - 2.0, unit() * 6.0 - 3.0);
             let brute = triangles

@@ -237,14 +237,6 @@ pub struct TooLarge {
     pub usable_height: f64,
 }
 
-/// Axis-aligned bounds of points.
-pub fn bounds(points: impl IntoIterator<Item = DVec2>) -> (DVec2, DVec2) {
-    points.into_iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), p| (lo.min(p), hi.max(p)),
-    )
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

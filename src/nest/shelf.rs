@@ -5,7 +5,8 @@
 
 use glam::DVec2;
 
-use super::{bounds, Layout, Placement, SheetSpec, TooLarge};
+use super::{Layout, Placement, SheetSpec, TooLarge};
+use crate::plane::bounds;
 
 /// A part's chosen rotation and bounding box at that rotation.
 #[derive(Clone, Copy, Debug)]

@@ -39,8 +39,8 @@ mod separate;
 
 use super::grid::Grid;
 use super::rng::SplitMix64;
-use super::{bounds, Layout, Placement, SheetSpec, TooLarge};
-use crate::plane::{convex_hull, offset_outline};
+use super::{Layout, Placement, SheetSpec, TooLarge};
+use crate::plane::{bounds, convex_hull, offset_outline};
 
 /// Search settings of the true-shape nester.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -891,9 +891,7 @@ mod tests {
             margin: 5.0,
             spacing: 2.0,
         };
-        let bar: Vec<DVec2> = [(0.0, 0.0), (40.0, 0.0), (40.0, 10.0), (0.0, 10.0)]
-            .map(|(x, y)| DVec2::new(x, y))
-            .to_vec();
+        let bar = super::super::test_rectangle(40.0, 10.0);
         let all = |mirrored| (0..4).map(move |q| (q, mirrored));
         assert_eq!(
             square_turns(&bar, sheet, &options(32, false)),
@@ -909,8 +907,7 @@ mod tests {
             [(0, false), (2, false)]
         );
         // A bar longer than the sheet is tall (440 mm on 300): upright and steep
-        // orientations are dropped, and
-        // the square ones are still the lying ones.
+        // orientations are dropped, and the square ones are still the lying ones.
         let long: Vec<DVec2> = bar.iter().map(|p| DVec2::new(p.x * 11.0, p.y)).collect();
         assert_eq!(
             square_turns(&long, sheet, &options(32, false)),
