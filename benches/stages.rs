@@ -10,8 +10,8 @@ use glam::DVec2;
 
 use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
 use unfold::export::{draw_sheet, svg};
-use unfold::flatten::flatten;
-use unfold::labels::{fit_labels, LabelOptions};
+use unfold::flatten::unroll_and_fit;
+use unfold::labels::LabelOptions;
 use unfold::mesh::Mesh;
 use unfold::nest::{lay_out, NestSettings, NesterName, SheetSpec};
 use unfold::panel::FlatPanel;
@@ -44,9 +44,9 @@ fn flat_panels(job: &Job, mesh: &Mesh) -> Vec<FlatPanel> {
         .panels
         .iter()
         .map(|p| {
-            let mut flat = flatten(p).expect("unrolls");
-            fit_labels(&mut flat, &p.labels, LabelOptions::default());
-            flat
+            unroll_and_fit(p, LabelOptions::default())
+                .expect("unrolls")
+                .0
         })
         .collect()
 }
@@ -96,8 +96,7 @@ fn schemes_and_flatten(c: &mut Criterion) {
             flatten_group.bench_function(BenchmarkId::new(scheme.to_string(), &name), |b| {
                 b.iter(|| {
                     for p in &output.panels {
-                        let mut flat = flatten(p).unwrap();
-                        fit_labels(&mut flat, &p.labels, LabelOptions::default());
+                        unroll_and_fit(p, LabelOptions::default()).unwrap();
                     }
                 })
             });

@@ -47,6 +47,19 @@ const FLAT_FOLD: f64 = 1e-9;
 /// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
 /// first edge along +x); every other facet is placed across a hinge.
 pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
+    unroll(panel).map(|(flat, _)| flat)
+}
+
+/// The isometry of every facet of `panel` between 3D and the flat panel that
+/// [`flatten`] makes of it: the flat panel's map back to 3D for any point (a hole, a
+/// label). Flat panels do not keep it (a million panels would carry a hundred bytes
+/// per facet for it), so it is computed again, by the same unrolling, where wanted.
+pub fn facet_frames(panel: &Panel) -> Result<Vec<FacetFrame>, FlattenError> {
+    unroll(panel).map(|(_, frames)| frames)
+}
+
+/// The flat panel and its facet frames.
+fn unroll(panel: &Panel) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
     let fail_id = || panel.id().to_string();
     let normals: Vec<DVec3> = panel
         .facets
@@ -180,18 +193,28 @@ pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
             facet: h.facet,
         })
         .collect();
-    Ok(FlatPanel {
+    let flat = FlatPanel {
         source: panel.source,
         points,
-        facets: panel.facets.clone(),
-        frames,
         outline: outline.into_iter().collect(),
         scores,
         holes,
         labels: Vec::new(),
         developability_error,
         area,
-    })
+    };
+    Ok((flat, frames))
+}
+
+/// Unrolls a panel and fits its labels: the flatten stage for one panel. Returns how
+/// many labels were left out.
+pub fn unroll_and_fit(
+    panel: &Panel,
+    options: LabelOptions,
+) -> Result<(FlatPanel, LeftOut), FlattenError> {
+    let (mut flat, frames) = unroll(panel)?;
+    let left_out = fit_labels(&mut flat, panel, &frames, options);
+    Ok((flat, left_out))
 }
 
 /// Unrolls every panel and fits its labels (the pipeline's flatten stage), in
@@ -204,19 +227,22 @@ pub fn unroll_all(
 ) -> Result<(Vec<FlatPanel>, LeftOut), FlattenError> {
     let unrolled: Vec<Result<(FlatPanel, LeftOut), FlattenError>> = panels
         .par_iter()
-        .map(|panel| {
-            let mut flat = flatten(panel)?;
-            let left_out = fit_labels(&mut flat, &panel.labels, options);
-            Ok((flat, left_out))
+        .map(|panel| unroll_and_fit(panel, options))
+        .collect();
+    if let Some(error) = unrolled.iter().find_map(|r| r.as_ref().err()) {
+        return Err(error.clone());
+    }
+    // Collected in place (the standard library reuses the buffer of `unrolled`): a
+    // second vector of a million flat panels would double their headers' memory.
+    let mut left_out = LeftOut::default();
+    let flat = unrolled
+        .into_iter()
+        .map(|result| {
+            let (panel, dropped) = result.expect("errors returned above");
+            left_out = left_out + dropped;
+            panel
         })
         .collect();
-    let mut flat = Vec::with_capacity(unrolled.len());
-    let mut left_out = LeftOut::default();
-    for result in unrolled {
-        let (panel, dropped) = result?;
-        flat.push(panel);
-        left_out = left_out + dropped;
-    }
     Ok((flat, left_out))
 }
 
@@ -312,7 +338,7 @@ mod tests {
         // The hole maps into the plane and back to the same 3D point.
         let hole = &flat.holes[0];
         assert!(hole.center.distance(DVec2::new(1.5, 0.5)) < 1e-12);
-        let back = flat.frames[1].to_3d(hole.center);
+        let back = facet_frames(&folded_strip()).unwrap()[1].to_3d(hole.center);
         assert!(back.distance(DVec3::new(1.0, 0.5, 0.5)) < 1e-12);
     }
 

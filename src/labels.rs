@@ -5,7 +5,7 @@
 use glam::DVec2;
 
 use crate::font::text_width;
-use crate::panel::{FlatLabel, FlatPanel, Label, LabelKind};
+use crate::panel::{FacetFrame, FlatLabel, FlatPanel, LabelKind, Loops, Panel};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
 
 /// Label fitting settings (mm).
@@ -78,15 +78,18 @@ impl std::ops::Add for LeftOut {
     }
 }
 
-/// Fits the labels a scheme wants on a panel (the 3D panel's labels, mapped
-/// through the flat panel's facet frames); returns how many of each kind were left
-/// out. Panel ids go first, then partner ids, then marks, so the important ones get
-/// the room.
+/// Fits the labels a scheme wants on a panel (the 3D panel `source`'s labels, mapped
+/// through the facet frames of its unrolling); returns how many of each kind were
+/// left out. Panel ids go first, then partner ids, then marks, so the important ones
+/// get the room.
 pub fn fit_labels(
     panel: &mut FlatPanel,
-    wanted_labels: &[Label],
+    source: &Panel,
+    frames: &[FacetFrame],
     options: LabelOptions,
 ) -> LeftOut {
+    let wanted_labels = &source.labels;
+    let facets = &source.facets;
     let mut order: Vec<usize> = (0..wanted_labels.len()).collect();
     order.sort_by_key(|&i| (wanted_labels[i].kind, i));
     let mut placed: Vec<[DVec2; 4]> = Vec::new();
@@ -94,7 +97,7 @@ pub fn fit_labels(
     let mut dropped = LeftOut::default();
     for i in order {
         let wanted = &wanted_labels[i];
-        let frame = panel.frames[wanted.facet as usize];
+        let frame = frames[wanted.facet as usize];
         let mut attempts = vec![Attempt {
             facet: wanted.facet as usize,
             anchor: frame.to_2d(wanted.anchor),
@@ -105,11 +108,19 @@ pub fn fit_labels(
         if wanted.kind == LabelKind::Panel {
             // A panel without its id cannot be found: if the wanted place is too
             // small, try the panel's largest facets.
-            attempts.extend(fallback_attempts(panel, wanted.facet as usize));
+            attempts.extend(fallback_attempts(panel, facets, wanted.facet as usize));
         }
         let text_width = text_width(wanted.text);
         let fitted = attempts.iter().find_map(|attempt| {
-            fit_one(panel, attempt, text_width, wanted.height, &placed, options)
+            fit_one(
+                panel,
+                facets,
+                attempt,
+                text_width,
+                wanted.height,
+                &placed,
+                options,
+            )
         });
         match fitted {
             Some((center, direction, height, bx)) => {
@@ -139,9 +150,8 @@ struct Attempt {
 }
 
 /// The three largest other facets, each at its centroid along its longest edge.
-fn fallback_attempts(panel: &FlatPanel, skip: usize) -> Vec<Attempt> {
-    let mut facets: Vec<(f64, usize)> = panel
-        .facets
+fn fallback_attempts(panel: &FlatPanel, facets: &Loops, skip: usize) -> Vec<Attempt> {
+    let mut by_area: Vec<(f64, usize)> = facets
         .iter()
         .enumerate()
         .filter(|&(k, _)| k != skip)
@@ -150,12 +160,12 @@ fn fallback_attempts(panel: &FlatPanel, skip: usize) -> Vec<Attempt> {
             (crate::plane::area(&pts), k)
         })
         .collect();
-    facets.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-    facets
+    by_area.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    by_area
         .into_iter()
         .take(3)
         .map(|(_, k)| {
-            let pts: Vec<DVec2> = panel.facets[k]
+            let pts: Vec<DVec2> = facets[k]
                 .iter()
                 .map(|&i| panel.points[i as usize])
                 .collect();
@@ -182,6 +192,7 @@ fn fallback_attempts(panel: &FlatPanel, skip: usize) -> Vec<Attempt> {
 /// fits in its attempt's facet: (centre, direction, height, box).
 fn fit_one(
     panel: &FlatPanel,
+    facets: &Loops,
     attempt: &Attempt,
     text_width: f64,
     wanted: f64,
@@ -192,7 +203,7 @@ fn fit_one(
     if direction == DVec2::ZERO {
         return None;
     }
-    let facet: Vec<DVec2> = panel.facets[attempt.facet]
+    let facet: Vec<DVec2> = facets[attempt.facet]
         .iter()
         .map(|&k| panel.points[k as usize])
         .collect();
@@ -205,7 +216,14 @@ fn fit_one(
     } else {
         vec![0.0]
     };
+    // A box inside the facet has less area than the facet: heights whose box is
+    // larger are skipped untested (the same heights are visited, so the result is
+    // that of testing them all). Most labels of tiny panels fail here at once.
+    let room = crate::plane::area(&facet).abs();
     let mut height = wanted;
+    while height >= options.min_height && text_width * height * height > room {
+        height *= SHRINK;
+    }
     while height >= options.min_height {
         for &shift in &slides {
             let mut center = attempt.anchor + shift * direction;

@@ -363,16 +363,16 @@ pub struct FlatLabel {
 }
 
 /// A panel unrolled into the plane, outside face up (its facets counter-clockwise).
+/// Its points have the 3D panel's vertex indices (so the 3D panel's facets index them)
+/// and its holes are the 3D panel's, in order: that is its map back to 3D, and
+/// [`crate::flatten::facet_frames`] gives the isometry of each facet for any other
+/// point.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlatPanel {
     /// Provenance (and so the printed id).
     pub source: Source,
     /// Corner positions in the plane (same indices as the 3D panel's vertices).
     pub points: Vec<DVec2>,
-    /// Facets (same as the 3D panel's).
-    pub facets: Loops,
-    /// The isometry of every facet (for mapping holes and labels back to 3D).
-    pub frames: Vec<FacetFrame>,
     /// Cut loops: the outer outline first (counter-clockwise), then inner cuts
     /// (clockwise).
     pub outline: Loops,

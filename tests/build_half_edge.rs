@@ -24,8 +24,8 @@ use tempfile::TempDir;
 
 use common::build::{
     check_output, check_sheets, close, count, distance_to_border, entry_names, finish,
-    folder_files, golden_build, inside, inspect_json, model, num, obj_face_count, panels_of,
-    read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck,
+    folder_files, frames_of, golden_build, inside, inspect_json, model, num, obj_face_count,
+    panels_of, read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck,
 };
 use unfold::config::{Job, SchemeName};
 use unfold::mesh::EdgeId;
@@ -277,6 +277,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
     let tmp = TempDir::new().unwrap();
     let job = half_edge_job(model, size, holes, &tmp.path().join("out"));
     let (mesh, connections, panels, flat) = panels_of(&job);
+    let frames = frames_of(&panels);
     let tol = rel_tol * size_mm;
     let r = 0.5 * job.scheme_options.hole_diameter;
 
@@ -284,7 +285,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
     // planar faces; faces planar only within --planarity-tol are kept as one facet,
     // and a point mapped back through the frame lands on the frame's plane.
     let flatness = |k: usize, facet: u32| -> f64 {
-        let frame = flat[k].frames[facet as usize];
+        let frame = frames[k][facet as usize];
         let normal = frame.x3.cross(frame.y3);
         panels[k].facets[facet as usize]
             .iter()
@@ -304,7 +305,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
         assert_eq!(fp.holes.len(), panels[k].holes.len(), "{what}: {}", fp.id());
         for hole in &fp.holes {
             total += 1;
-            let facet: Vec<DVec2> = fp.facets[hole.facet as usize]
+            let facet: Vec<DVec2> = panels[k].facets[hole.facet as usize]
                 .iter()
                 .map(|&i| fp.points[i as usize])
                 .collect();
@@ -323,7 +324,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
                 fp.id(),
                 hole.connection
             );
-            let p = fp.frames[hole.facet as usize].to_3d(hole.center);
+            let p = frames[k][hole.facet as usize].to_3d(hole.center);
             by_connection
                 .entry(hole.connection)
                 .or_default()
@@ -403,7 +404,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
         } else {
             (&on_a, &on_b, b)
         };
-        let frame = flat[band_panel].frames[0];
+        let frame = frames[band_panel][0];
         let normal = frame.x3.cross(frame.y3);
         let slack = 2.0 * flatness(band_panel, 0);
         let mut matched = BTreeSet::new();
@@ -490,9 +491,9 @@ fn holes_of_a_connection_meet_in_3d_on_near_planar_faces() {
     let fertility = shared.join("fertility.obj");
     let tmp = TempDir::new().unwrap();
     let job = half_edge_job(&fertility, "4ft", 2, &tmp.path().join("out"));
-    let (_mesh, _connections, _panels, flat) = panels_of(&job);
-    for fp in &flat {
-        for (k, f) in fp.frames.iter().enumerate() {
+    let (_mesh, _connections, panels, flat) = panels_of(&job);
+    for (fp, frames) in flat.iter().zip(frames_of(&panels)) {
+        for (k, f) in frames.iter().enumerate() {
             assert!(
                 (f.x3.length() - 1.0).abs() < 1e-12
                     && (f.y3.length() - 1.0).abs() < 1e-12
@@ -829,8 +830,8 @@ fn labels_are_inside_their_panels() {
     let (mesh, connections, panels, mut flat) = panels_of(&job);
     assert_eq!(connections, 100);
     let mut left_out = 0;
-    for (fp, panel) in flat.iter_mut().zip(&panels) {
-        left_out += unfold::labels::fit_labels(fp, &panel.labels, Default::default()).total();
+    for ((fp, panel), frames) in flat.iter_mut().zip(&panels).zip(frames_of(&panels)) {
+        left_out += unfold::labels::fit_labels(fp, panel, &frames, Default::default()).total();
     }
     assert_eq!(left_out, 0);
     let mut partner_labels = 0;

@@ -254,7 +254,7 @@ fn check_panels(p: &Pipeline, job: &Job, what: &str) {
         let area = signed_area(&outer);
         assert!(area > 0.0, "{what}: {} is laid face down", fp.id());
         let mut facets_area = 0.0;
-        for (k, facet) in fp.facets.iter().enumerate() {
+        for (k, facet) in panel.facets.iter().enumerate() {
             let a = signed_area(&fp.loop_points(facet));
             assert!(
                 a > 0.0,
@@ -580,7 +580,7 @@ fn check_holes(
                 hole.connection,
                 hole.facet
             );
-            let facet = fp.loop_points(&fp.facets[hole.facet as usize]);
+            let facet = fp.loop_points(&panel.facets[hole.facet as usize]);
             assert!(
                 inside(&facet, hole.center),
                 "{what}: {} hole of connection {} outside its flap",
@@ -594,7 +594,7 @@ fn check_holes(
                 fp.id(),
                 hole.connection
             );
-            let frame = fp.frames[hole.facet as usize];
+            let frame = p.frames[k][hole.facet as usize];
             let point = frame.to_3d(hole.center);
             let normal = frame.x3.cross(frame.y3);
             let foot = hole3.position - (hole3.position - frame.origin3).dot(normal) * normal;
@@ -1039,7 +1039,13 @@ fn open_meshes_give_boundary_edges_a_single_flap() {
             .unwrap_or_else(|| panic!("{what}: no count in {line:?}"));
         assert_eq!(said, boundary, "{what}: {line}");
         // The single-flap panels are the boundary edges'.
-        let single: Vec<&FlatPanel> = p.flat.iter().filter(|fp| fp.facets.len() == 1).collect();
+        let single: Vec<&FlatPanel> = p
+            .flat
+            .iter()
+            .zip(&p.output.panels)
+            .filter(|(_, panel)| panel.facets.len() == 1)
+            .map(|(fp, _)| fp)
+            .collect();
         assert_eq!(single.len(), boundary, "{what}: single-flap panels");
         for fp in single {
             assert!(

@@ -67,9 +67,9 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
     let p = pipeline(job);
     let size = 300.0;
     let mut by_connection: BTreeMap<u32, BTreeMap<String, Vec<DVec3>>> = BTreeMap::new();
-    for flat in &p.flat {
+    for (flat, frames) in p.flat.iter().zip(&p.frames) {
         for hole in &flat.holes {
-            let back = flat.frames[hole.facet as usize].to_3d(hole.center);
+            let back = frames[hole.facet as usize].to_3d(hole.center);
             by_connection
                 .entry(hole.connection)
                 .or_default()

@@ -140,9 +140,9 @@ fn the_holes_of_a_lap_joint_meet_in_3d() {
         let job = woven_job(name, "200mm", tmp.path());
         let p = pipeline(&job);
         let mut by_joint: BTreeMap<u32, Vec<(String, u32, DVec3)>> = BTreeMap::new();
-        for flat in &p.flat {
+        for (flat, frames) in p.flat.iter().zip(&p.frames) {
             for hole in &flat.holes {
-                let back = flat.frames[hole.facet as usize].to_3d(hole.center);
+                let back = frames[hole.facet as usize].to_3d(hole.center);
                 by_joint.entry(hole.connection).or_default().push((
                     flat.id().to_string(),
                     hole.facet,

@@ -14,10 +14,10 @@ use serde_json::Value;
 
 use super::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
 use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
-use unfold::flatten::flatten;
+use unfold::flatten::{facet_frames, flatten};
 use unfold::mesh::split::SplitReport;
 use unfold::mesh::Mesh;
-use unfold::panel::{FlatPanel, Panel};
+use unfold::panel::{FacetFrame, FlatPanel, Panel};
 use unfold::scheme::{build_panels, SchemeOutput};
 
 // =======================================================================================
@@ -511,6 +511,8 @@ pub struct Pipeline {
     pub output: SchemeOutput,
     /// The panels unrolled, in the same order.
     pub flat: Vec<FlatPanel>,
+    /// The facet frames of every flat panel (its map back to 3D), in the same order.
+    pub frames: Vec<Vec<FacetFrame>>,
 }
 
 /// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
@@ -525,12 +527,22 @@ pub fn pipeline(job: &Job) -> Pipeline {
         .iter()
         .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
         .collect();
+    let frames = frames_of(&output.panels);
     Pipeline {
         mesh,
         split,
         output,
         flat,
+        frames,
     }
+}
+
+/// The facet frames of each panel's unrolling (the flat panels' maps back to 3D).
+pub fn frames_of(panels: &[Panel]) -> Vec<Vec<FacetFrame>> {
+    panels
+        .iter()
+        .map(|p| facet_frames(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
+        .collect()
 }
 
 /// [`pipeline`] as a tuple: the mesh the scheme used, the number of connections, the 3D
