@@ -63,11 +63,12 @@ fn main() -> anyhow::Result<()> {
         output.panels.iter().map(count).sum::<usize>() as f64 / output.panels.len().max(1) as f64
     };
     println!(
-        "per panel: {:.1} vertices, {:.1} facets, {:.1} holes, {:.1} labels ({:.1} fitted)",
+        "per panel: {:.1} vertices, {:.1} facets, {:.1} holes, {:.1} labels kept ({:.1} dropped as too large for any facet; {:.1} fitted)",
         per_panel(&|p| p.vertices.len()),
         per_panel(&|p| p.facets.len()),
         per_panel(&|p| p.holes.len()),
         per_panel(&|p| p.labels.len()),
+        per_panel(&|p| p.labels_dropped.total()),
         flat.iter().map(|p| p.labels.len()).sum::<usize>() as f64 / flat.len().max(1) as f64,
     );
     let peak_kib = memory_kib("VmHWM:").unwrap_or(0);

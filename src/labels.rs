@@ -2,28 +2,60 @@
 //! box fits inside its facet (with a margin), clear of holes and of labels already
 //! placed; otherwise it shrinks, and below the smallest legible height it is left out.
 
-use glam::DVec2;
+use glam::{DVec2, DVec3};
 
 use crate::font::text_width;
-use crate::panel::{FacetFrame, FlatLabel, FlatPanel, LabelKind, Loops, Panel};
+use crate::mesh::geometry::vector_area;
+use crate::panel::{FacetFrame, FlatLabel, FlatPanel, Label, LabelKind, Loops, Panel};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
+
+/// Smallest cap height worth engraving (mm).
+pub const MIN_HEIGHT: f64 = 1.5;
 
 /// Label fitting settings (mm).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LabelOptions {
-    /// Smallest cap height worth engraving.
-    pub min_height: f64,
     /// Free space kept around a label's box.
     pub margin: f64,
 }
 
 impl Default for LabelOptions {
     fn default() -> Self {
-        Self {
-            min_height: 1.5,
-            margin: 0.5,
-        }
+        Self { margin: 0.5 }
     }
+}
+
+/// Takes out of `labels` (of a 3D panel with these vertices and facets) those that
+/// cannot fit at any height fitting would try: the wanted height is below
+/// [`MIN_HEIGHT`], or the text box at [`MIN_HEIGHT`] has more area than the label's
+/// facet (than the largest facet for a panel id, which may move to another). A box
+/// inside a facet has less area than it, and a facet's area in the plane is at most
+/// its 3D vector area, so these labels would be left out anyway: dropping them early
+/// changes no output. Returns how many of each kind were dropped.
+pub fn drop_unfittable(vertices: &[DVec3], facets: &Loops, labels: &mut Vec<Label>) -> LeftOut {
+    let mut dropped = LeftOut::default();
+    if labels.is_empty() {
+        return dropped;
+    }
+    let areas: Vec<f64> = facets
+        .iter()
+        .map(|f| vector_area(f.iter().map(|&i| vertices[i as usize])).length())
+        .collect();
+    let largest = areas.iter().copied().fold(0.0, f64::max);
+    labels.retain(|label| {
+        let room = match label.kind {
+            LabelKind::Panel => largest,
+            _ => areas.get(label.facet as usize).copied().unwrap_or(largest),
+        };
+        // 1 % of slack for the rounding between the 3D and the flat areas.
+        let fits = label.height >= MIN_HEIGHT
+            && text_width(label.text) * MIN_HEIGHT * MIN_HEIGHT <= 1.01 * room;
+        if !fits {
+            dropped.count(label.kind);
+        }
+        fits
+    });
+    dropped
 }
 
 /// Shrink factor per attempt.
@@ -94,7 +126,7 @@ pub fn fit_labels(
     order.sort_by_key(|&i| (wanted_labels[i].kind, i));
     let mut placed: Vec<[DVec2; 4]> = Vec::new();
     let mut labels = Vec::new();
-    let mut dropped = LeftOut::default();
+    let mut dropped = source.labels_dropped;
     for i in order {
         let wanted = &wanted_labels[i];
         let frame = frames[wanted.facet as usize];
@@ -221,10 +253,10 @@ fn fit_one(
     // that of testing them all). Most labels of tiny panels fail here at once.
     let room = crate::plane::area(&facet).abs();
     let mut height = wanted;
-    while height >= options.min_height && text_width * height * height > room {
+    while height >= MIN_HEIGHT && text_width * height * height > room {
         height *= SHRINK;
     }
-    while height >= options.min_height {
+    while height >= MIN_HEIGHT {
         for &shift in &slides {
             let mut center = attempt.anchor + shift * direction;
             if attempt.on_edge {
@@ -292,4 +324,84 @@ fn grow(bx: &[DVec2; 4], d: f64) -> [DVec2; 4] {
         bx[2] + d * along + d * up,
         bx[3] - d * along + d * up,
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::flatten::unroll_and_fit;
+    use crate::panel::{Name, Source};
+
+    fn label(text: Name, kind: LabelKind, facet: u32, height: f64, anchor: DVec3) -> Label {
+        Label {
+            text,
+            anchor,
+            direction: DVec3::Y,
+            height,
+            facet,
+            kind,
+            on_edge: false,
+            slide: 0.0,
+        }
+    }
+
+    /// A 20 mm square facet hinged to a 0.2 mm wide strip folded up by 90°.
+    fn square_and_strip(labels: Vec<Label>) -> Panel {
+        Panel::new(
+            Source::Edge(7),
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(20.0, 0.0, 0.0),
+                DVec3::new(20.0, 20.0, 0.0),
+                DVec3::new(0.0, 20.0, 0.0),
+                DVec3::new(20.0, 0.0, 0.2),
+                DVec3::new(20.0, 20.0, 0.2),
+            ],
+            [vec![0, 1, 2, 3], vec![1, 4, 5, 2]].into_iter().collect(),
+            Vec::new(),
+            labels,
+        )
+    }
+
+    #[test]
+    fn labels_that_cannot_fit_are_dropped_early_without_changing_the_fit() {
+        let on_strip = DVec3::new(20.0, 10.0, 0.1);
+        let on_square = DVec3::new(4.0, 10.0, 0.0);
+        let wanted = vec![
+            // The panel id may move to the square: kept.
+            label(Name::Edge(7), LabelKind::Panel, 1, 3.0, on_strip),
+            // A partner id on the 4 mm² strip: its box at 1.5 mm is larger.
+            label(Name::Edge(123), LabelKind::Partner, 1, 3.0, on_strip),
+            // A mark on the square: kept.
+            label(Name::Vertex(5), LabelKind::Mark, 0, 3.0, on_square),
+            // Wanted below the legible height: never tried.
+            label(Name::Face(9), LabelKind::Mark, 0, 1.0, on_square),
+        ];
+        assert!(text_width(Name::Edge(123)) * MIN_HEIGHT * MIN_HEIGHT > 1.01 * 4.0);
+        let pruned = square_and_strip(wanted.clone());
+        let kinds: Vec<LabelKind> = pruned.labels.iter().map(|l| l.kind).collect();
+        assert_eq!(kinds, [LabelKind::Panel, LabelKind::Mark]);
+        assert_eq!(
+            pruned.labels_dropped,
+            LeftOut {
+                panel: 0,
+                partner: 1,
+                mark: 1
+            }
+        );
+        // The same panel keeping every label fits the same labels, at the same places,
+        // and leaves out as many of each kind.
+        let full = Panel {
+            labels: wanted,
+            labels_dropped: LeftOut::default(),
+            ..pruned.clone()
+        };
+        let options = LabelOptions::default();
+        let (flat_pruned, out_pruned) = unroll_and_fit(&pruned, options).unwrap();
+        let (flat_full, out_full) = unroll_and_fit(&full, options).unwrap();
+        assert_eq!(flat_pruned.labels, flat_full.labels);
+        assert_eq!(flat_pruned.labels.len(), 2, "{:?}", flat_pruned.labels);
+        assert_eq!(out_pruned, out_full);
+        assert_eq!(out_full.total(), 2);
+    }
 }

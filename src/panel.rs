@@ -8,6 +8,8 @@
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
+use crate::labels::LeftOut;
+
 /// Which mesh element a panel was made from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -246,13 +248,19 @@ pub struct Panel {
     pub facets: Loops,
     /// Fastener holes.
     pub holes: Vec<Hole>,
-    /// Labels.
+    /// Labels that may fit (see [`Panel::new`]).
     pub labels: Vec<Label>,
+    /// The labels the scheme wanted that cannot fit on any facet at a legible height,
+    /// dropped when the panel was made; label fitting counts them as left out.
+    pub labels_dropped: LeftOut,
 }
 
 impl Panel {
     /// A panel from its parts, holding no spare capacity: the schemes build panels by
-    /// pushing, and a big job keeps millions of them until the end.
+    /// pushing, and a big job keeps millions of them until the end. Labels whose text
+    /// box at the smallest legible height has more area than any facet they may go on
+    /// are dropped here (and counted): at a million panels they would take more memory
+    /// than the panels' geometry, and fitting would leave them out anyway.
     pub fn new(
         source: Source,
         mut vertices: Vec<DVec3>,
@@ -260,6 +268,7 @@ impl Panel {
         mut holes: Vec<Hole>,
         mut labels: Vec<Label>,
     ) -> Self {
+        let labels_dropped = crate::labels::drop_unfittable(&vertices, &facets, &mut labels);
         vertices.shrink_to_fit();
         facets.shrink_to_fit();
         holes.shrink_to_fit();
@@ -270,6 +279,7 @@ impl Panel {
             facets,
             holes,
             labels,
+            labels_dropped,
         }
     }
 
