@@ -1,7 +1,8 @@
 //! Unrolling a 3D panel into the plane: breadth-first over its facets, each rotated
 //! about the hinge it shares with an already placed facet. The result is an isometry
-//! per facet, so holes and labels map both ways, and the developability error is the
-//! largest change of any facet edge length.
+//! per facet (used to place holes and labels, and given again by [`facet_frames`] to
+//! map any flat point back to 3D), and the developability error is the largest change
+//! of any facet edge length.
 
 use std::collections::VecDeque;
 

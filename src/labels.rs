@@ -49,7 +49,7 @@ pub fn drop_unfittable(vertices: &[DVec3], facets: &Loops, labels: &mut Vec<Labe
         };
         // 1 % of slack for the rounding between the 3D and the flat areas.
         let fits = label.height >= MIN_HEIGHT
-            && text_width(label.text) * MIN_HEIGHT * MIN_HEIGHT <= 1.01 * room;
+            && box_area(text_width(label.text), MIN_HEIGHT) <= 1.01 * room;
         if !fits {
             dropped.count(label.kind);
         }
@@ -71,6 +71,13 @@ pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [D
         center + along + up,
         center - along + up,
     ]
+}
+
+/// The area of a label's box at cap height `height` ([`label_box`] of width
+/// `text_width * height`): what the early drop and the height skip compare with a
+/// facet's area.
+fn box_area(text_width: f64, height: f64) -> f64 {
+    text_width * height * height
 }
 
 /// How many labels of each kind were left out.
@@ -251,9 +258,9 @@ fn fit_one(
     // A box inside the facet has less area than the facet: heights whose box is
     // larger are skipped untested (the same heights are visited, so the result is
     // that of testing them all). Most labels of tiny panels fail here at once.
-    let room = crate::plane::area(&facet).abs();
+    let room = crate::plane::area(&facet);
     let mut height = wanted;
-    while height >= MIN_HEIGHT && text_width * height * height > room {
+    while height >= MIN_HEIGHT && box_area(text_width, height) > room {
         height *= SHRINK;
     }
     while height >= MIN_HEIGHT {
@@ -377,7 +384,7 @@ mod tests {
             // Wanted below the legible height: never tried.
             label(Name::Face(9), LabelKind::Mark, 0, 1.0, on_square),
         ];
-        assert!(text_width(Name::Edge(123)) * MIN_HEIGHT * MIN_HEIGHT > 1.01 * 4.0);
+        assert!(box_area(text_width(Name::Edge(123)), MIN_HEIGHT) > 1.01 * 4.0);
         let pruned = square_and_strip(wanted.clone());
         let kinds: Vec<LabelKind> = pruned.labels.iter().map(|l| l.kind).collect();
         assert_eq!(kinds, [LabelKind::Panel, LabelKind::Mark]);

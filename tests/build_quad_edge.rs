@@ -26,8 +26,9 @@ use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
-    check_output, check_sheets, count, distance_to_border, golden_build, inside, inspect_json,
-    model, num, pipeline, read_simple_obj, resolve, shared_models, DxfCheck, Pipeline, Run,
+    check_output, check_sheets, count, distance_to_border, frames_of, golden_build, inside,
+    inspect_json, model, num, pipeline, read_simple_obj, resolve, shared_models, DxfCheck,
+    Pipeline, Run,
 };
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job, SchemeName};
@@ -546,6 +547,7 @@ fn check_holes(
     let tol = rel_tol * size_mm;
     let n = o.samples as usize;
     let exact = 1e-9 * size_mm;
+    let frames = frames_of(&p.output.panels);
 
     // connection → [(panel index, unrolled point mapped back to 3D, the 3D hole)]
     let mut by_connection: BTreeMap<u32, Vec<(usize, DVec3, DVec3)>> = BTreeMap::new();
@@ -594,7 +596,7 @@ fn check_holes(
                 fp.id(),
                 hole.connection
             );
-            let frame = p.frames[k][hole.facet as usize];
+            let frame = frames[k][hole.facet as usize];
             let point = frame.to_3d(hole.center);
             let normal = frame.x3.cross(frame.y3);
             let foot = hole3.position - (hole3.position - frame.origin3).dot(normal) * normal;

@@ -16,8 +16,8 @@ use glam::DVec3;
 use tempfile::TempDir;
 
 use common::build::{
-    build, check_output, check_sheets, count, golden_build, model, options, pipeline, resolve,
-    DxfCheck,
+    build, check_output, check_sheets, count, frames_of, golden_build, model, options, pipeline,
+    resolve, DxfCheck,
 };
 use unfold::config::SchemeName;
 
@@ -67,7 +67,7 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
     let p = pipeline(job);
     let size = 300.0;
     let mut by_connection: BTreeMap<u32, BTreeMap<String, Vec<DVec3>>> = BTreeMap::new();
-    for (flat, frames) in p.flat.iter().zip(&p.frames) {
+    for (flat, frames) in p.flat.iter().zip(frames_of(&p.output.panels)) {
         for hole in &flat.holes {
             let back = frames[hole.facet as usize].to_3d(hole.center);
             by_connection

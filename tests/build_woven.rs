@@ -16,8 +16,8 @@ use glam::DVec3;
 use tempfile::TempDir;
 
 use common::build::{
-    build, check_output, count, folder_files, golden_build, model, options, pipeline, resolve,
-    unfold_command, DxfCheck,
+    build, check_output, count, folder_files, frames_of, golden_build, model, options, pipeline,
+    resolve, unfold_command, DxfCheck,
 };
 use unfold::config::SchemeName;
 use unfold::mesh::geometry::vector_area;
@@ -140,7 +140,7 @@ fn the_holes_of_a_lap_joint_meet_in_3d() {
         let job = woven_job(name, "200mm", tmp.path());
         let p = pipeline(&job);
         let mut by_joint: BTreeMap<u32, Vec<(String, u32, DVec3)>> = BTreeMap::new();
-        for (flat, frames) in p.flat.iter().zip(&p.frames) {
+        for (flat, frames) in p.flat.iter().zip(frames_of(&p.output.panels)) {
             for hole in &flat.holes {
                 let back = frames[hole.facet as usize].to_3d(hole.center);
                 by_joint.entry(hole.connection).or_default().push((

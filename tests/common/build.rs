@@ -511,8 +511,6 @@ pub struct Pipeline {
     pub output: SchemeOutput,
     /// The panels unrolled, in the same order.
     pub flat: Vec<FlatPanel>,
-    /// The facet frames of every flat panel (its map back to 3D), in the same order.
-    pub frames: Vec<Vec<FacetFrame>>,
 }
 
 /// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
@@ -527,13 +525,11 @@ pub fn pipeline(job: &Job) -> Pipeline {
         .iter()
         .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
         .collect();
-    let frames = frames_of(&output.panels);
     Pipeline {
         mesh,
         split,
         output,
         flat,
-        frames,
     }
 }
 
