@@ -138,6 +138,14 @@ impl Loops {
         Self::default()
     }
 
+    /// No loops, with room for `loops` loops of `indices` indices in all.
+    pub fn with_capacity(loops: usize, indices: usize) -> Self {
+        Loops {
+            indices: Vec::with_capacity(indices),
+            ends: Vec::with_capacity(loops),
+        }
+    }
+
     /// Appends a loop.
     pub fn push(&mut self, lp: impl IntoIterator<Item = u32>) {
         self.indices.extend(lp);

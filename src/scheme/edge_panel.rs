@@ -18,22 +18,101 @@ pub fn panel_id(e: EdgeId) -> Name {
     Name::Edge(e.0)
 }
 
-/// One face's share of the edge panels, in 3D.
+/// One face's share of the edge panels, in 3D: the band, each band edge's flap outline,
+/// the holes through each flap and where each corner's vertex id goes. A big job holds
+/// one per face until every panel is built, so it keeps everything in three buffers
+/// rather than a vector per flap.
 #[derive(Clone, Debug, Default)]
 pub struct FaceFlaps {
-    /// Band corners B_k (corner k at the origin of the face's k-th half-edge).
-    pub band: Vec<DVec3>,
-    /// Per band edge k (B_k → B_k+1): the flap's outline after B_k, B_k+1,
-    /// counter-clockwise.
-    pub flap_rest: Vec<Vec<DVec3>>,
-    /// Per band edge k: the holes through that flap, with their connection ids.
-    pub flap_holes: Vec<Vec<(DVec3, u32)>>,
-    /// Per corner k: where the vertex id goes (between the pins).
-    pub corner_label: Vec<DVec3>,
+    /// The band corners B_k (corner k at the origin of the face's k-th half-edge), then
+    /// each corner's label point, then the rest of every flap, one after the other.
+    points: Vec<DVec3>,
+    /// Number of band corners.
+    corners: usize,
+    /// Where the rest of each flap ends in `points`.
+    rest_ends: Vec<u32>,
+    /// Holes as (centre, connection, flap), in the order they were added.
+    holes: Vec<(DVec3, u32, u32)>,
     /// Connections (face corners) with fewer holes than wanted.
     pub reduced: usize,
     /// Connections with no hole at all although holes were wanted.
     pub bare: usize,
+}
+
+impl FaceFlaps {
+    /// A face with these band corners and no flaps yet: push one flap per band edge in
+    /// order, and set every corner's label point.
+    pub fn new(band: &[DVec3], flap_points: usize) -> Self {
+        let n = band.len();
+        let mut points = Vec::with_capacity(2 * n + flap_points);
+        points.extend_from_slice(band);
+        points.resize(2 * n, band.first().copied().unwrap_or_default());
+        FaceFlaps {
+            points,
+            corners: n,
+            rest_ends: Vec::with_capacity(n),
+            holes: Vec::new(),
+            reduced: 0,
+            bare: 0,
+        }
+    }
+
+    /// Number of band corners (and edges, and flaps).
+    pub fn corners(&self) -> usize {
+        self.corners
+    }
+
+    /// Band corners.
+    pub fn band(&self) -> &[DVec3] {
+        &self.points[..self.corners]
+    }
+
+    /// Appends the next flap's outline after B_k, B_k+1 (counter-clockwise).
+    pub fn push_flap(&mut self, rest: impl IntoIterator<Item = DVec3>) {
+        self.points.extend(rest);
+        self.rest_ends.push(self.points.len() as u32);
+    }
+
+    /// Sets where corner `k`'s vertex id goes (between its pins).
+    pub fn set_corner_label(&mut self, k: usize, p: DVec3) {
+        self.points[self.corners + k] = p;
+    }
+
+    /// Where corner `k`'s vertex id goes.
+    pub fn corner_label(&self, k: usize) -> DVec3 {
+        self.points[self.corners + k]
+    }
+
+    /// Flap `k`'s outline after B_k, B_k+1.
+    pub fn flap_rest(&self, k: usize) -> &[DVec3] {
+        let start = if k == 0 {
+            2 * self.corners
+        } else {
+            self.rest_ends[k - 1] as usize
+        };
+        &self.points[start..self.rest_ends[k] as usize]
+    }
+
+    /// A hole through both flaps meeting at a connection.
+    pub fn add_hole(&mut self, flaps: [usize; 2], p: DVec3, connection: u32) {
+        for flap in flaps {
+            self.holes.push((p, connection, flap as u32));
+        }
+    }
+
+    /// The holes through flap `k` with their connection ids.
+    pub fn flap_holes(&self, k: usize) -> impl Iterator<Item = (DVec3, u32)> + '_ {
+        self.holes
+            .iter()
+            .filter(move |h| h.2 as usize == k)
+            .map(|h| (h.0, h.1))
+    }
+
+    /// Frees what no more flap or hole will use (a big job keeps one per face).
+    pub fn shrink_to_fit(&mut self) {
+        self.points.shrink_to_fit();
+        self.holes.shrink_to_fit();
+    }
 }
 
 /// A 2D frame in a face's plane, centred on the face centre.
@@ -151,7 +230,7 @@ pub fn edge_scheme(
         .map(|f| face_flaps(mesh, FaceId(f), options))
         .collect();
     let panels = edge_panels(mesh, &faces, options);
-    let connections: usize = faces.iter().map(|f| f.band.len()).sum();
+    let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
     super::SchemeOutput {
         panels,
         connections,
@@ -206,7 +285,8 @@ fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
 }
 
 /// The panel of edge `e`: flap in f, bend strips, flap in f′ (or the flap alone on the
-/// boundary).
+/// boundary). Every buffer is sized exactly before it is filled: a big job builds
+/// millions of panels and keeps them all.
 fn edge_panel(
     mesh: &Mesh,
     e: EdgeId,
@@ -221,106 +301,94 @@ fn edge_panel(
         e.half_edge()
     };
     let f = mesh.face(h).expect("an edge has a face on one side");
-    let twin_face = mesh.face(h.twin());
     let part = &faces[f.index()];
     let k = corner_of[h.index()] as usize;
-    let k1 = (k + 1) % part.band.len();
-
-    let mut vertices: Vec<DVec3> = Vec::new();
-    let push = |p: DVec3, vertices: &mut Vec<DVec3>| {
-        vertices.push(p);
-        (vertices.len() - 1) as u32
+    let k1 = (k + 1) % part.corners();
+    // The face across, its flaps and the corner the twin leaves from.
+    let across = mesh
+        .face(h.twin())
+        .map(|g| (g, &faces[g.index()], corner_of[h.twin().index()] as usize));
+    // Bend strips (none on the boundary).
+    let n = if across.is_some() {
+        options.samples.max(1) as usize
+    } else {
+        0
     };
-    let mut facets = Loops::new();
-    let mut holes = Vec::new();
-    let mut labels = Vec::new();
+    let rest_f = part.flap_rest(k);
+    let rest_g = across.map_or(&[][..], |(_, other, k2)| other.flap_rest(k2));
 
-    // Rails (at v and at v′) sampled at the same t on both, so rulings stay parallel
-    // to the edge.
-    let (rail_v, rail_w): (Vec<u32>, Vec<u32>) = match twin_face {
-        Some(g) => {
-            let other = &faces[g.index()];
-            let k2 = corner_of[h.twin().index()] as usize;
+    // The rails at v and at v′ come first, in pairs sampled at the same t on both (so
+    // rulings stay parallel to the edge): rail point i is vertex 2i at v, 2i + 1 at v′.
+    let mut vertices: Vec<DVec3> = Vec::with_capacity(2 * (n + 1) + rest_f.len() + rest_g.len());
+    let (rail_v, rail_w) = (|i: usize| 2 * i as u32, |i: usize| 2 * i as u32 + 1);
+    match across {
+        Some((_, other, k2)) => {
             let (v, w) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
             let m = 0.5 * (v + w);
             let b = options.bridge_scale;
             let (cv, cw) = (b * v + (1.0 - b) * m, b * w + (1.0 - b) * m);
             // In g the twin runs w → v: band corner k2 is at w, k2 + 1 at v.
-            let (gv, gw) = (other.band[(k2 + 1) % other.band.len()], other.band[k2]);
-            let n = options.samples.max(1);
-            (0..=n)
-                .map(|i| {
-                    let t = i as f64 / n as f64;
-                    let a = push(bezier(part.band[k], cv, gv, t), &mut vertices);
-                    let b = push(bezier(part.band[k1], cw, gw, t), &mut vertices);
-                    (a, b)
-                })
-                .unzip()
+            let band_g = other.band();
+            let (gv, gw) = (band_g[(k2 + 1) % band_g.len()], band_g[k2]);
+            let band_f = part.band();
+            for i in 0..=n {
+                let t = i as f64 / n as f64;
+                vertices.push(bezier(band_f[k], cv, gv, t));
+                vertices.push(bezier(band_f[k1], cw, gw, t));
+            }
         }
-        None => {
-            let a = push(part.band[k], &mut vertices);
-            let b = push(part.band[k1], &mut vertices);
-            (vec![a], vec![b])
-        }
-    };
+        None => vertices.extend([part.band()[k], part.band()[k1]]),
+    }
 
+    let mut facets = Loops::with_capacity(n + 2, 4 + rest_f.len() + 4 * n + rest_g.len());
+    let hole_count = part.flap_holes(k).count()
+        + across.map_or(0, |(_, other, k2)| other.flap_holes(k2).count());
+    let mut holes = Vec::with_capacity(hole_count);
     let mut add_flap = |part: &FaceFlaps,
                         edge: usize,
                         start: u32,
                         end: u32,
                         vertices: &mut Vec<DVec3>,
                         facets: &mut Loops| {
-        let mut flap = vec![start, end];
-        for &p in &part.flap_rest[edge] {
-            flap.push(push(p, vertices));
-        }
+        let first = vertices.len() as u32;
+        let rest = part.flap_rest(edge);
+        vertices.extend_from_slice(rest);
         let facet = facets.len() as u32;
-        facets.push(flap);
-        for &(p, connection) in &part.flap_holes[edge] {
-            holes.push(Hole {
-                position: p,
-                diameter: options.hole_diameter,
-                connection,
-                facet,
-            });
-        }
+        facets.push(
+            [start, end]
+                .into_iter()
+                .chain(first..first + rest.len() as u32),
+        );
+        holes.extend(part.flap_holes(edge).map(|(p, connection)| Hole {
+            position: p,
+            diameter: options.hole_diameter,
+            connection,
+            facet,
+        }));
         facet
     };
-    add_flap(part, k, rail_v[0], rail_w[0], &mut vertices, &mut facets);
-
-    let n = rail_v.len() - 1;
-    let mut flap_g = None;
-    if let Some(g) = twin_face {
+    add_flap(part, k, rail_v(0), rail_w(0), &mut vertices, &mut facets);
+    let flap_g = across.map(|(g, other, k2)| {
         for i in 0..n {
-            facets.push(vec![rail_w[i], rail_v[i], rail_v[i + 1], rail_w[i + 1]]);
+            facets.push([rail_w(i), rail_v(i), rail_v(i + 1), rail_w(i + 1)]);
         }
-        let k2 = corner_of[h.twin().index()] as usize;
-        let facet = add_flap(
-            &faces[g.index()],
-            k2,
-            rail_w[n],
-            rail_v[n],
-            &mut vertices,
-            &mut facets,
-        );
-        flap_g = Some((g, k2, facet));
-    }
+        let facet = add_flap(other, k2, rail_w(n), rail_v(n), &mut vertices, &mut facets);
+        (g, other, k2, facet)
+    });
 
     // The panel id: on the middle strip of the bend, along the edge (on the flap for a
     // boundary edge).
     let (a, b) = (
-        vertices[rail_v[n / 2] as usize],
-        vertices[rail_w[n / 2] as usize],
+        vertices[rail_v(n / 2) as usize],
+        vertices[rail_w(n / 2) as usize],
     );
     let id_facet = if n > 0 { 1 + n / 2 } else { 0 };
     let id_facet = id_facet.min(facets.len() - 1);
-    let corners: Vec<DVec3> = facets[id_facet]
-        .iter()
-        .map(|&i| vertices[i as usize])
-        .collect();
+    let corners = &facets[id_facet];
+    let mut labels = Vec::with_capacity(1 + FLAP_LABELS * (1 + usize::from(n > 0)));
     labels.push(Label {
         text: panel_id(e),
-        anchor: corners.iter().copied().sum::<DVec3>() / corners.len() as f64,
+        anchor: corners.iter().map(|&i| vertices[i as usize]).sum::<DVec3>() / corners.len() as f64,
         direction: (b - a).normalize(),
         height: options.label_height,
         facet: id_facet as u32,
@@ -329,21 +397,15 @@ fn edge_panel(
         slide: 0.3 * a.distance(b),
     });
     flap_labels(mesh, part, f, h, k, 0, options, &mut labels);
-    if let Some((g, k2, facet)) = flap_g {
-        flap_labels(
-            mesh,
-            &faces[g.index()],
-            g,
-            h.twin(),
-            k2,
-            facet,
-            options,
-            &mut labels,
-        );
+    if let Some((g, other, k2, facet)) = flap_g {
+        flap_labels(mesh, other, g, h.twin(), k2, facet, options, &mut labels);
     }
 
     Panel::new(Source::Edge(e.0), vertices, facets, holes, labels)
 }
+
+/// Labels [`flap_labels`] puts on a flap.
+const FLAP_LABELS: usize = 5;
 
 /// Labels on a flap: the partner panel's id toward each of its two corners, the vertex
 /// id at each corner's pins, the face id in the middle (in that priority).
@@ -358,9 +420,9 @@ fn flap_labels(
     options: &SchemeOptions,
     labels: &mut Vec<Label>,
 ) {
-    let next_corner = (corner + 1) % part.band.len();
-    let (a, b) = (part.band[corner], part.band[next_corner]);
-    let rest = &part.flap_rest[corner];
+    let next_corner = (corner + 1) % part.corners();
+    let (a, b) = (part.band()[corner], part.band()[next_corner]);
+    let rest = part.flap_rest(corner);
     let middle = (a + b + rest.iter().copied().sum::<DVec3>()) / (2 + rest.len()) as f64;
     let along = (b - a).normalize();
     let ends = [
@@ -371,7 +433,7 @@ fn flap_labels(
         labels.push(Label {
             text: panel_id(partner.edge()),
             // Between the flap's middle and the pins at that corner.
-            anchor: 0.5 * (middle + part.corner_label[c]),
+            anchor: 0.5 * (middle + part.corner_label(c)),
             direction: along,
             height: options.label_height,
             facet,
@@ -383,7 +445,7 @@ fn flap_labels(
     for (_, c, vertex) in ends {
         labels.push(Label {
             text: Name::Vertex(vertex.0),
-            anchor: part.corner_label[c],
+            anchor: part.corner_label(c),
             direction: along,
             height: options.label_height,
             facet,

@@ -56,17 +56,10 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         })
         .collect();
 
-    let mut parts = FaceFlaps {
-        band: band3,
-        flap_rest: flaps
-            .iter()
-            .map(|f| f.iter().skip(2).map(|&q| frame.to3(q)).collect())
-            .collect(),
-        flap_holes: vec![Vec::new(); n],
-        corner_label: Vec::with_capacity(n),
-        reduced: 0,
-        bare: 0,
-    };
+    let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
+    for flap in &flaps {
+        parts.push_flap(flap.iter().skip(2).map(|&q| frame.to3(q)));
+    }
     for k in 0..n {
         let prev = (k + n - 1) % n;
         // The overlap at corner k: the previous edge's flap clipped by this edge's strip.
@@ -77,7 +70,7 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         } else {
             overlap.iter().copied().sum::<DVec2>() / overlap.len() as f64
         };
-        parts.corner_label.push(frame.to3(centre));
+        parts.set_corner_label(k, frame.to3(centre));
         // Pins along the line from the corner through the overlap's centre.
         let (pins, fewer) = place_pins(
             &overlap,
@@ -92,10 +85,9 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         // meeting there carry its holes.
         let connection = half_edges[k].0;
         for pin in pins {
-            let p = frame.to3(pin);
-            parts.flap_holes[prev].push((p, connection));
-            parts.flap_holes[k].push((p, connection));
+            parts.add_hole([prev, k], frame.to3(pin), connection);
         }
     }
+    parts.shrink_to_fit();
     parts
 }

@@ -74,19 +74,13 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         }
     }
 
-    let mut parts = FaceFlaps {
-        band: band3,
-        flap_rest: rest
-            .iter()
-            .map(|r| r.iter().map(|&q| frame.to3(q)).collect())
-            .collect(),
-        flap_holes: vec![Vec::new(); n],
-        corner_label: (0..n)
-            .map(|k| frame.to3(0.5 * (at(k) + inner(k))))
-            .collect(),
-        reduced: 0,
-        bare: 0,
-    };
+    let mut parts = FaceFlaps::new(&band3, rest.iter().map(Vec::len).sum());
+    for r in &rest {
+        parts.push_flap(r.iter().map(|&q| frame.to3(q)));
+    }
+    for k in 0..n {
+        parts.set_corner_label(k, frame.to3(0.5 * (at(k) + inner(k))));
+    }
     let mut placed_at_corner = vec![0usize; n];
     let mut short_at_corner = vec![false; n];
     for (corner, [e1, e2], region) in &shared {
@@ -98,9 +92,7 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         placed_at_corner[*corner] += pins.len();
         let connection = half_edges[*corner].0;
         for pin in pins {
-            let p = frame.to3(pin);
-            parts.flap_holes[*e1].push((p, connection));
-            parts.flap_holes[*e2].push((p, connection));
+            parts.add_hole([*e1, *e2], frame.to3(pin), connection);
         }
     }
     parts.reduced = short_at_corner.iter().filter(|&&s| s).count();
@@ -109,5 +101,6 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
     } else {
         0
     };
+    parts.shrink_to_fit();
     parts
 }
