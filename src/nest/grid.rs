@@ -79,6 +79,21 @@ impl Grid {
         }
     }
 
+    /// Whether a point lies outside the grid or in an occupied cell.
+    pub fn blocked(&self, x: f32, y: f32) -> bool {
+        let (cx, cy) = ((x - self.x0) / self.cell, (y - self.y0) / self.cell);
+        if !(cx >= 0.0 && cy >= 0.0) {
+            return true;
+        }
+        let (col, row) = (cx as usize, cy as usize);
+        col >= self.cols || row >= self.rows || self.occupied[row * self.cols + col]
+    }
+
+    /// Side of a cell.
+    pub fn cell(&self) -> f32 {
+        self.cell
+    }
+
     /// Empties the grid.
     pub fn clear(&mut self) {
         self.occupied.fill(false);
@@ -134,6 +149,10 @@ mod tests {
         );
         // Cell 10 of 100 (row 1, col 0) is occupied by the square: every draw misses.
         assert!(p.is_none());
+        // Blocked: occupied cells and anything off the grid.
+        assert!(g.blocked(25.0, 25.0));
+        assert!(!g.blocked(75.0, 25.0));
+        assert!(g.blocked(-0.1, 25.0) && g.blocked(25.0, 100.5) && g.blocked(f32::NAN, 1.0));
         g.clear();
         assert_eq!(g.free_area(), 10_000.0);
     }

@@ -4,7 +4,8 @@
 //! Collision detection is jagua-rs (every part inflated by half the spacing, the sheet
 //! grown by the same amount); the search is ours:
 //! 1. constructive: parts largest first, each into the first sheet where a sampled,
-//!    then slid, bottom-left position is free (first-fit decreasing on true shapes);
+//!    then slid, bottom-left position is free (first-fit decreasing on true shapes),
+//!    poses that touch their neighbours scoring better ([`CONTACT_WEIGHT`]);
 //! 2. improvement: the emptiest sheet is emptied into the others, part by part, with a
 //!    wider search; a sheet left empty is dropped. Partial moves are kept: they only
 //!    make the emptiest sheet emptier (the second objective);
@@ -70,6 +71,16 @@ const SIMPLIFY: f32 = 0.001;
 
 /// Weight of the x coordinate in the bottom-left score (y counts 1).
 const LEFT_WEIGHT: f32 = 0.2;
+
+/// Bonus in the placement score for an outline that touches placed parts or the
+/// sheet's edge, per part size (square root of its area) at full contact. Bottom-left
+/// alone leaves a part wherever its top is lowest, often in a corner that leaves a
+/// gap no other part fills; preferring poses that hug their neighbours packs tighter.
+/// Measured at weight 1 against 0 (default effort): the knight half-edge 14 → 13
+/// sheets; spot half-edge's last sheet 26 % → 9 % full and fertility's 29 % → 21 %,
+/// same counts; the bunny, suzanne, horse_quad (half-, quad-, winged-edge, woven) and
+/// spot quad-edge same counts. Weights 0.5 and 2 did no better.
+const CONTACT_WEIGHT: f32 = 1.0;
 
 /// How far (mm) inside the sheet's bounds a clamped candidate stays.
 const EDGE_GAP: f32 = 0.01;
@@ -404,6 +415,45 @@ fn make_item(
     )
     .ok()
     .map(Arc::new)
+}
+
+/// Share of a posed shape's outline that has a placed part or the sheet's edge within
+/// one grid cell outside it: probes one cell apart along every edge, one cell out,
+/// looked up in the occupancy grid (coarse, but it only ranks free poses).
+fn contact_share(grid: &Grid, shape: &SPolygon) -> f32 {
+    let v = shape.vertices();
+    let n = v.len();
+    let signed: f32 = (0..n)
+        .map(|i| {
+            let (a, b) = (v[i], v[(i + 1) % n]);
+            a.0 * b.1 - b.0 * a.1
+        })
+        .sum();
+    let out = if signed >= 0.0 { 1.0 } else { -1.0 };
+    let d = grid.cell();
+    let (mut hits, mut total) = (0u32, 0u32);
+    for i in 0..n {
+        let (a, b) = (v[i], v[(i + 1) % n]);
+        let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+        let len = (dx * dx + dy * dy).sqrt();
+        if len <= 0.0 {
+            continue;
+        }
+        // Outward normal of a counter-clockwise loop is (dy, -dx).
+        let (nx, ny) = (out * dy / len * d, -out * dx / len * d);
+        let k = (len / d).ceil().max(1.0) as u32;
+        for j in 0..k {
+            let t = (j as f32 + 0.5) / k as f32;
+            let (x, y) = (a.0 + t * dx + nx, a.1 + t * dy + ny);
+            total += 1;
+            hits += grid.blocked(x, y) as u32;
+        }
+    }
+    if total == 0 {
+        0.0
+    } else {
+        hits as f32 / total as f32
+    }
 }
 
 /// Marks the cells under a placed part.
@@ -807,7 +857,8 @@ impl<'a> Nester<'a> {
         self.parts[part].item.shape_cd().as_ref().clone()
     }
 
-    /// The bottom-left score of a pose, or `None` when it collides. `scratch` must
+    /// The placement score of a pose (bottom-left, less the contact bonus), or `None`
+    /// when it collides. `scratch` must
     /// come from [`Self::scratch_for`] of the same part; the caller counts the check.
     fn score_if_free(
         &self,
@@ -828,7 +879,8 @@ impl<'a> Nester<'a> {
             return None;
         }
         let bb = scratch.bbox();
-        Some(bb.y_max + LEFT_WEIGHT * bb.x_max)
+        let contact = contact_share(&self.sheets[s].grid, scratch);
+        Some(bb.y_max + LEFT_WEIGHT * bb.x_max - CONTACT_WEIGHT * contact * scratch.area().sqrt())
     }
 
     /// Placements in part order; sheets fullest first (ties by the order they opened).
@@ -885,6 +937,39 @@ mod tests {
                 ((quarters.round() as i64) % 4, or.mirrored)
             })
             .collect()
+    }
+
+    #[test]
+    fn contact_share_counts_the_outline_near_parts_and_edges() {
+        let mut grid = Grid::new(0.0, 0.0, 100.0, 100.0, 100);
+        let square = |x: f32, y: f32, side: f32| {
+            SPolygon::new(vec![
+                Point(x, y),
+                Point(x + side, y),
+                Point(x + side, y + side),
+                Point(x, y + side),
+            ])
+            .expect("a square")
+        };
+        // Alone in the middle: nothing near.
+        assert_eq!(contact_share(&grid, &square(40.0, 40.0, 20.0)), 0.0);
+        // In the corner: two of four sides on the sheet's edge.
+        let corner = contact_share(&grid, &square(0.1, 0.1, 20.0));
+        assert!((corner - 0.5).abs() < 0.01, "{corner}");
+        // A placed part right of it covers a third side.
+        let right: Vec<(f32, f32)> = square(20.3, 0.0, 30.0)
+            .vertices()
+            .iter()
+            .map(|p| (p.0, p.1))
+            .collect();
+        grid.fill_polygon(&right);
+        let hugged = contact_share(&grid, &square(0.1, 0.1, 20.0));
+        assert!((hugged - 0.75).abs() < 0.01, "{hugged}");
+        // Clockwise or counter-clockwise, the probes go outside.
+        let mut cw = square(40.0, 40.0, 20.0).vertices().to_vec();
+        cw.reverse();
+        let cw = SPolygon::new(cw).expect("a square");
+        assert_eq!(contact_share(&grid, &cw), 0.0);
     }
 
     #[test]
