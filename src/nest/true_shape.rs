@@ -863,8 +863,8 @@ impl<'a> Nester<'a> {
     }
 
     /// The placement score of a pose (bottom-left, less the contact bonus), or `None`
-    /// when it collides. `scratch` must
-    /// come from [`Self::scratch_for`] of the same part; the caller counts the check.
+    /// when it collides. `scratch` must come from [`Self::scratch_for`] of the same
+    /// part; the caller counts the check.
     fn score_if_free(
         &self,
         s: usize,
