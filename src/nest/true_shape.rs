@@ -424,17 +424,12 @@ fn make_item(
 
 /// Share of a posed shape's outline that has a placed part or the sheet's edge within
 /// one grid cell outside it: probes one cell apart along every edge, one cell out,
-/// looked up in the occupancy grid (coarse, but it only ranks free poses).
+/// looked up in the occupancy grid (coarse, but it only ranks free poses). jagua-rs
+/// keeps every polygon counter-clockwise, mirrored poses included (it reverses their
+/// corners), so the outside is always on the right of an edge.
 fn contact_share(grid: &Grid, shape: &SPolygon) -> f32 {
     let v = shape.vertices();
     let n = v.len();
-    let signed: f32 = (0..n)
-        .map(|i| {
-            let (a, b) = (v[i], v[(i + 1) % n]);
-            a.0 * b.1 - b.0 * a.1
-        })
-        .sum();
-    let out = if signed >= 0.0 { 1.0 } else { -1.0 };
     let d = grid.cell();
     let (mut hits, mut total) = (0u32, 0u32);
     for i in 0..n {
@@ -444,8 +439,8 @@ fn contact_share(grid: &Grid, shape: &SPolygon) -> f32 {
         if len <= 0.0 {
             continue;
         }
-        // Outward normal of a counter-clockwise loop is (dy, -dx).
-        let (nx, ny) = (out * dy / len * d, -out * dx / len * d);
+        // The outward normal of a counter-clockwise loop is (dy, -dx).
+        let (nx, ny) = (dy / len * d, -dx / len * d);
         let k = (len / d).ceil().max(1.0) as u32;
         for j in 0..k {
             let t = (j as f32 + 0.5) / k as f32;
@@ -970,11 +965,16 @@ mod tests {
         grid.fill_polygon(&right);
         let hugged = contact_share(&grid, &square(0.1, 0.1, 20.0));
         assert!((hugged - 0.75).abs() < 0.01, "{hugged}");
-        // Clockwise or counter-clockwise, the probes go outside.
-        let mut cw = square(40.0, 40.0, 20.0).vertices().to_vec();
-        cw.reverse();
-        let cw = SPolygon::new(cw).expect("a square");
-        assert_eq!(contact_share(&grid, &cw), 0.0);
+        // A mirrored pose still probes outside: mirrored about y = 10.1 (the engine
+        // reflects y, then translates), the corner square lands on itself and touches
+        // the same edges and part.
+        let reference = square(0.1, 0.1, 20.0);
+        let mut mirrored = reference.clone();
+        let mirror = DTransformation::new(0.0, (0.0, 20.2)).with_reflection(true);
+        mirrored.transform_from(&reference, &mirror.compose());
+        assert!(mirrored.vertices().iter().all(|p| p.1 > 0.0 && p.1 < 20.2));
+        let share = contact_share(&grid, &mirrored);
+        assert!((share - 0.75).abs() < 0.01, "{share}");
     }
 
     #[test]

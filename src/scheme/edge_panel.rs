@@ -22,7 +22,7 @@ pub fn panel_id(e: EdgeId) -> Name {
 /// the holes through each flap and where each corner's vertex id goes. A big job holds
 /// one per face until every panel is built, so it keeps everything in three buffers
 /// rather than a vector per flap.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct FaceFlaps {
     /// The band corners B_k (corner k at the origin of the face's k-th half-edge), then
     /// each corner's label point, then the rest of every flap, one after the other.
@@ -40,13 +40,14 @@ pub struct FaceFlaps {
 }
 
 impl FaceFlaps {
-    /// A face with these band corners and no flaps yet: push one flap per band edge in
-    /// order, and set every corner's label point.
+    /// A face with these band corners and no flaps yet, with room for `flap_points`
+    /// points of flap outline in all: push one flap per band edge in order, and set
+    /// every corner's label point (until then it is NaN, so a forgotten one shows).
     pub fn new(band: &[DVec3], flap_points: usize) -> Self {
         let n = band.len();
         let mut points = Vec::with_capacity(2 * n + flap_points);
         points.extend_from_slice(band);
-        points.resize(2 * n, band.first().copied().unwrap_or_default());
+        points.resize(2 * n, DVec3::NAN);
         FaceFlaps {
             points,
             corners: n,
