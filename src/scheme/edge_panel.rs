@@ -341,7 +341,11 @@ fn edge_panel(
         None => vertices.extend([part.band()[k], part.band()[k1]]),
     }
 
-    let mut facets = Loops::with_capacity(n + 2, 4 + rest_f.len() + 4 * n + rest_g.len());
+    // One flap on a boundary edge, two otherwise; each flap is its two rail ends and
+    // its rest, each bend strip a quad.
+    let flaps = 1 + usize::from(across.is_some());
+    let mut facets =
+        Loops::with_capacity(flaps + n, 2 * flaps + rest_f.len() + rest_g.len() + 4 * n);
     let hole_count = part.flap_holes(k).count()
         + across.map_or(0, |(_, other, k2)| other.flap_holes(k2).count());
     let mut holes = Vec::with_capacity(hole_count);
