@@ -540,8 +540,9 @@ pub struct BuildOptions {
     #[serde(default)]
     pub mirror: bool,
 
-    /// Wall-clock cap on the nester's improvement, in seconds. Off by default, since a
-    /// time cap makes the result depend on the machine. [default: none]
+    /// Wall-clock cap on the nester's improvement and squeeze, in seconds. Off by
+    /// default, since a time cap makes the result depend on the machine.
+    /// [default: none]
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
 

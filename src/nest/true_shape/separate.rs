@@ -1,18 +1,28 @@
 //! Overlap minimisation, after sparrow (Gardeyn and Wauters, 2025): to take a sheet
-//! away, its parts first go where they overlap least on the other sheets; then, sheet
-//! by sheet, every overlapping part is moved to its pose of least weighted overlap,
-//! and the weight of every pair still overlapping grows (a guided local search), until
-//! nothing overlaps or the rounds run out. The sheets are separated one after the
-//! other with the one seeded generator; a part moves off its sheet only when the last
-//! few overlapping parts find a free place on another one.
+//! away, its parts go one at a time, largest first, to where they overlap least on one
+//! of the emptiest other sheets; that sheet is then separated: every overlapping part
+//! is moved to its pose of least weighted overlap, and the weight of every pair still
+//! overlapping grows (a guided local search), until nothing overlaps or the rounds or
+//! strikes run out, when the sheet is put back as it was.
+//!
+//! The separation's cost is in evaluating overlap: collecting every collision of a
+//! pose, where the constructive search stops at the first, and weighing the disc
+//! pairs. The effort budget counts each evaluation as [`OVERLAP_CHECK_COST`] checks
+//! plus one per [`DISC_PAIRS_PER_CHECK`] disc pairs, fitted to the times measured on
+//! the bunny and the knight (an evaluation took about 2 µs plus 2 ns per disc pair,
+//! against 0.3 µs for a constructive check). On sheets holding hundreds of parts
+//! (horse_quad quad-edge) an evaluation takes about twice what it counts.
 //!
 //! Overlap between two parts is measured on discs inside their collision shapes (the
-//! engine's poles and a lattice of inscribed discs): the sum over disc pairs of the
-//! penetration depth times the smaller radius, which shrinks smoothly as parts move
-//! apart. Outlines that touch where no discs reach (tab tips) count a small floor, so
-//! every collision costs something.
+//! engine's poles and a lattice of inscribed discs), as sparrow does: for every pair of
+//! discs, the penetration depth times the smaller radius, where a depth below a small
+//! epsilon (1 % of the larger part's diameter) decays smoothly instead of dropping to
+//! zero, so that two discs about to touch still count a little. The loss of a pair of
+//! parts is the square root of that sum plus epsilon squared (so every collision costs
+//! something, tab tips included), times the geometric mean of the square roots of
+//! their convex hulls' areas (large parts left overlapping cost more).
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use jagua_rs::collision_detection::hazards::collector::BasicHazardCollector;
 use jagua_rs::collision_detection::hazards::filter::NoFilter;
@@ -29,29 +39,37 @@ const LATTICE_POINTS: usize = 400;
 /// Discs kept per part (the largest).
 const MAX_DISCS: usize = 32;
 
-/// Overlap counted for two outlines that collide where no discs overlap, as a share of
-/// the smaller of their largest discs' squared radii.
-const FLOOR: f32 = 0.05;
+/// Epsilon of the overlap measure, as a share of the larger part's diameter.
+const EPSILON_SHARE: f32 = 0.01;
 
 /// Cost of a pose outside the sheet (never chosen while any other pose exists).
 const OUTSIDE: f32 = 1e12;
 
-/// Growth of a pair's weight per round it keeps overlapping (the most overlapping
-/// pair grows by the most, others proportionally less).
-const WEIGHT_GROWTH: f32 = 0.6;
+/// Growth of a pair's weight per round it keeps overlapping: the most overlapping pair
+/// by the factor `1 + WEIGHT_GROWTH.1`, the others proportionally less, down to
+/// `1 + WEIGHT_GROWTH.0` (sparrow's 1.2 to 2).
+const WEIGHT_GROWTH: (f32, f32) = (0.2, 1.0);
 
 /// Decay of a pair's weight per round it does not overlap (down to 1).
 const WEIGHT_DECAY: f32 = 0.95;
 
-/// Rounds without a 2 % drop of the total overlap before a sheet is given up.
-const STRIKES: u32 = 200;
+/// Rounds without a new least total overlap after which the separation goes back to
+/// the least-overlap state it saw (a strike).
+const ROUNDS_PER_STRIKE: u32 = 50;
 
-/// Overlapping parts on a sheet below which each first looks for a free place on
-/// another sheet.
-const RELOCATE_BELOW: usize = 5;
+/// Strikes in a row that did not lower the least total overlap by 2 % before a sheet
+/// is given up.
+const STRIKES: u32 = 3;
 
-/// Emptiest sheets a part of the sheet taken away may go to.
-const INSERT_SHEETS: usize = 3;
+/// Other sheets, emptiest first, that a part squeezed out of the emptiest sheet tries.
+const SQUEEZE_SHEETS: usize = 2;
+
+/// Collision checks one evaluation of a pose's overlap counts for in the effort
+/// budget, besides its disc pairs (see the module documentation).
+const OVERLAP_CHECK_COST: u64 = 8;
+
+/// Disc pairs of the overlap measure that cost one collision check of the budget.
+const DISC_PAIRS_PER_CHECK: usize = 128;
 
 /// Sampled poses per move, before the local descent.
 const MOVE_SAMPLES: usize = 48;
@@ -104,46 +122,39 @@ pub(super) fn overlap_discs(shape: &SPolygon) -> Vec<Circle> {
     discs
 }
 
-/// Overlap of two posed disc sets (mm²).
-fn disc_overlap(a: &[Circle], b: &[Circle]) -> f32 {
-    // Only the discs of `a` that reach the bounds of `b`'s discs.
-    let (lo, hi) = b.iter().fold(
-        (
-            Point(f32::INFINITY, f32::INFINITY),
-            Point(f32::NEG_INFINITY, f32::NEG_INFINITY),
-        ),
-        |(lo, hi), d| {
-            (
-                Point(
-                    lo.0.min(d.center.0 - d.radius),
-                    lo.1.min(d.center.1 - d.radius),
-                ),
-                Point(
-                    hi.0.max(d.center.0 + d.radius),
-                    hi.1.max(d.center.1 + d.radius),
-                ),
-            )
-        },
-    );
+/// Facts of a part that its overlap loss uses besides its discs.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct LossScale {
+    /// Largest distance across the collision shape (mm).
+    pub diameter: f32,
+    /// Square root of the area of its convex hull (mm).
+    pub hull_root: f32,
+}
+
+/// Overlap loss of two posed parts (their discs and scales): see the module
+/// documentation. Every pair of discs counts, however far
+/// apart: the decayed terms of discs that are close but apart are what tells two parts
+/// that only touch at their outlines how to move apart.
+fn pair_loss(a: &[Circle], b: &[Circle], sa: LossScale, sb: LossScale) -> f32 {
+    let eps = EPSILON_SHARE * sa.diameter.max(sb.diameter);
     let mut total = 0.0;
     for p in a {
-        if p.center.0 + p.radius <= lo.0
-            || p.center.0 - p.radius >= hi.0
-            || p.center.1 + p.radius <= lo.1
-            || p.center.1 - p.radius >= hi.1
-        {
-            continue;
-        }
         for q in b {
             let depth = p.radius + q.radius - p.center.distance_to(&q.center);
-            if depth > 0.0 {
-                total += depth * p.radius.min(q.radius);
-            }
+            let decayed = if depth >= eps {
+                depth
+            } else {
+                eps * eps / (2.0 * eps - depth)
+            };
+            total += decayed * p.radius.min(q.radius);
         }
     }
-    let floor = FLOOR * a[0].radius.min(b[0].radius).powi(2);
-    total.max(floor)
+    (std::f32::consts::PI * total + eps * eps).sqrt() * (sa.hull_root * sb.hull_root).sqrt()
 }
+
+/// Overlapping pairs of parts on a sheet (by part index, smaller first) and their
+/// overlap.
+type Pairs = BTreeMap<(usize, usize), f32>;
 
 /// Weights of overlapping pairs of parts (by part index, smaller first); 1 when absent.
 #[derive(Default)]
@@ -169,98 +180,73 @@ fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle
 }
 
 impl Nester<'_> {
-    /// Takes the emptiest sheet away: each of its parts, largest first, goes to its
-    /// pose of least overlap on whichever of the three emptiest other sheets (by the
-    /// area of their collision shapes) overlaps least, a free pose ending the search;
-    /// the sheets given overlaps are then separated. All or nothing: `false` leaves
-    /// the sheets as they were.
-    pub(super) fn eliminate_emptiest(&mut self, rounds: usize) -> bool {
-        if self.sheets.len() < 2 {
-            return false;
-        }
-        let target = self.emptiest();
-        let backup = self.sheets.clone();
-        let parts = self.parts;
-        let mut moving: Vec<usize> = self.sheets[target].parts.iter().map(|e| e.0).collect();
-        moving.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
-        self.sheets.remove(target);
-        let mut crowded: Vec<usize> = Vec::new();
-        for part in moving {
-            // The emptiest sheets by the area of their collision shapes (spacing
-            // included); the part goes where it overlaps least.
-            let mut by_fill: Vec<(f32, usize)> = (0..self.sheets.len())
-                .map(|s| {
-                    let used: f32 = self.sheets[s]
-                        .parts
-                        .iter()
-                        .map(|e| parts[e.0].item.shape_cd().area())
-                        .sum();
-                    (used, s)
-                })
-                .collect();
-            by_fill.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let mut best: Option<(f32, usize, Candidate)> = None;
-            for &(_, s) in by_fill.iter().take(INSERT_SHEETS) {
-                let c = self.least_overlap_pose(s, part, None, &Weights::default());
-                let cost = self.weighted_overlap(s, part, c, &Weights::default(), f32::INFINITY);
-                if best.is_none_or(|b| cost < b.0) {
-                    best = Some((cost, s, c));
-                }
-                if cost == 0.0 {
-                    break;
-                }
-            }
-            let (cost, s, c) = best.expect("at least one other sheet");
-            if cost > 0.0 && !crowded.contains(&s) {
-                crowded.push(s);
-            }
-            self.put(s, part, c);
-        }
-        crowded.sort_unstable();
-        for s in crowded {
-            if !self.separate(s, rounds) {
-                self.sheets = backup;
-                return false;
-            }
-        }
-        true
-    }
-
-    /// Moves the overlapping parts of sheet `s` until none overlaps (`true`), or
-    /// until `rounds` rounds or the strikes run out (`false`, the sheet overlapping).
-    fn separate(&mut self, s: usize, rounds: usize) -> bool {
+    /// Moves the overlapping parts of sheet `s`, whose overlapping pairs are `pairs`,
+    /// until none overlaps (`true`), or until `rounds` rounds or the strikes run out
+    /// (`false`, the sheet left in the least-overlap state seen). The pairs are kept
+    /// up to date for the parts that move, never found by scanning the sheet: a sheet
+    /// of a large job holds hundreds of parts, and scanning them all every round cost
+    /// more than the moves themselves.
+    fn separate(&mut self, s: usize, rounds: usize, mut pairs: Pairs) -> bool {
         let mut weights = Weights::default();
-        let mut best_total = f32::INFINITY;
+        // The least total overlap seen, and the poses and pairs in that state.
+        let mut least = f32::INFINITY;
+        let mut least_state: Option<(Vec<Candidate>, Pairs)> = None;
+        let mut since_least = 0;
+        let mut strike_start = f32::INFINITY;
         let mut strikes = 0;
         for _ in 0..rounds {
-            let pairs = self.overlapping_pairs(s);
+            // Confirmed on the whole sheet: only the pairs of the parts that moved
+            // are kept up to date, and a pair missed there would leave parts
+            // overlapping. The fail-fast check costs a fraction of a full scan.
             if pairs.is_empty() {
-                self.refill_grid(s);
-                return true;
+                self.checks += self.sheets[s].parts.len() as u64;
+                if self.sheets[s].layout.is_collision_free() {
+                    self.refill_grid(s);
+                    return true;
+                }
+                pairs = self.overlapping_pairs(s);
             }
             if self.out_of_budget() {
-                return false;
+                break;
             }
-            let total: f32 = pairs.iter().map(|p| p.2).sum();
-            if total < 0.98 * best_total {
-                best_total = total;
-                strikes = 0;
+            let total: f32 = pairs.values().sum();
+            if total < least {
+                least = total;
+                least_state = Some((self.poses_on(s), pairs.clone()));
+                since_least = 0;
             } else {
-                strikes += 1;
-                if strikes >= STRIKES {
-                    return false;
+                since_least += 1;
+                if since_least >= ROUNDS_PER_STRIKE {
+                    // A strike: back to the least-overlap state, weights kept.
+                    if least > 0.98 * strike_start {
+                        strikes += 1;
+                        if strikes >= STRIKES {
+                            break;
+                        }
+                    } else {
+                        strikes = 0;
+                    }
+                    strike_start = least;
+                    since_least = 0;
+                    if let Some((poses, saved)) = &least_state {
+                        self.restore_poses(s, poses);
+                        pairs = saved.clone();
+                    }
+                    continue;
                 }
             }
-            let largest = pairs.iter().map(|p| p.2).fold(0.0, f32::max);
+            let largest = pairs.values().copied().fold(0.0, f32::max);
             for w in weights.0.values_mut() {
                 *w = (*w * WEIGHT_DECAY).max(1.0);
             }
-            for &(a, b, overlap) in &pairs {
+            let (grow_least, grow_most) = WEIGHT_GROWTH;
+            for (&(a, b), &overlap) in &pairs {
                 let w = weights.0.entry((a, b)).or_insert(1.0);
+                let growth = grow_least + (grow_most - grow_least) * overlap / largest;
                 // Undo this round's decay, then grow.
-                *w = (*w / WEIGHT_DECAY).max(1.0) * (1.0 + WEIGHT_GROWTH * overlap / largest);
+                *w = (*w / WEIGHT_DECAY).max(1.0) * (1.0 + growth);
             }
-            let mut movers: Vec<usize> = pairs.iter().flat_map(|p| [p.0, p.1]).collect();
+            let mut movers: Vec<usize> = pairs.keys().flat_map(|&(a, b)| [a, b]).collect();
             movers.sort_unstable();
             movers.dedup();
             // Fisher–Yates with the seeded generator.
@@ -268,38 +254,99 @@ impl Nester<'_> {
                 let j = self.rng.below(i + 1);
                 movers.swap(i, j);
             }
-            // The last few overlapping parts may find a free place on another sheet.
-            let relocate = movers.len() <= RELOCATE_BELOW;
             for part in movers {
-                if self.overlaps_any(s, part) && !(relocate && self.relocate(s, part)) {
-                    self.move_part(s, part, &weights);
+                if !pairs.keys().any(|&(a, b)| a == part || b == part) {
+                    continue;
                 }
+                pairs.retain(|&(a, b), _| a != part && b != part);
+                self.move_part(s, part, &weights);
+                self.record_overlaps(s, part, &mut pairs);
             }
         }
+        // Given up: leave the least-overlap state (the caller restores or retries).
+        if let Some((poses, _)) = least_state {
+            self.restore_poses(s, &poses);
+        }
+        self.refill_grid(s);
         false
     }
 
-    /// Moves `part` from sheet `s` to a free pose on another sheet (emptiest first);
-    /// `false` when there is none.
-    fn relocate(&mut self, s: usize, part: usize) -> bool {
-        let mut by_fill: Vec<usize> = (0..self.sheets.len()).filter(|&t| t != s).collect();
-        by_fill.sort_by(|&a, &b| {
-            self.sheets[a]
-                .area
-                .total_cmp(&self.sheets[b].area)
-                .then(a.cmp(&b))
-        });
-        for t in by_fill {
-            if let Some(c) = self.search(t, part, self.samples) {
-                let slot = self.sheets[s]
+    /// The poses of the parts on sheet `s`, slot by slot.
+    fn poses_on(&self, s: usize) -> Vec<Candidate> {
+        self.sheets[s].parts.iter().map(|e| e.2).collect()
+    }
+
+    /// Puts the parts on sheet `s` back in `poses` (slot by slot, as
+    /// [`Nester::poses_on`] gave them), moving only the parts whose pose differs.
+    fn restore_poses(&mut self, s: usize, poses: &[Candidate]) {
+        for (slot, &c) in poses.iter().enumerate() {
+            let (part, key, now) = self.sheets[s].parts[slot];
+            if (now.orientation, now.x, now.y) == (c.orientation, c.x, c.y) {
+                continue;
+            }
+            let pose = self.pose(part, c);
+            let layout = &mut self.sheets[s].layout;
+            layout.remove_item(key);
+            let key = layout.place_item(&self.parts[part].item, pose);
+            self.sheets[s].parts[slot] = (part, key, c);
+        }
+    }
+
+    /// Squeezes the parts of the emptiest sheet, largest first, into the others one at
+    /// a time: each goes to its pose of least overlap on one of the emptiest other
+    /// sheets, which is then separated, and stays there only when that succeeds. Stops
+    /// at the first part that finds no room (the sheet cannot be emptied then, and the
+    /// parts after it would only spend effort). Returns whether the sheet went away.
+    pub(super) fn squeeze_emptiest(&mut self, rounds: usize) -> bool {
+        if self.sheets.len() < 2 {
+            return false;
+        }
+        let target = self.emptiest();
+        let parts = self.parts;
+        let mut moving: Vec<usize> = self.sheets[target].parts.iter().map(|e| e.0).collect();
+        moving.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
+        for part in moving {
+            if self.out_of_budget() || !self.squeeze_part(target, part, rounds) {
+                return false;
+            }
+        }
+        self.sheets.remove(target);
+        true
+    }
+
+    /// Moves `part` from sheet `from` into one of the emptiest other sheets by overlap
+    /// minimisation (see [`Nester::squeeze_emptiest`]); `false` leaves it where it was.
+    fn squeeze_part(&mut self, from: usize, part: usize, rounds: usize) -> bool {
+        let parts = self.parts;
+        let mut by_fill: Vec<(f32, usize)> = (0..self.sheets.len())
+            .filter(|&s| s != from)
+            .map(|s| {
+                let used: f32 = self.sheets[s]
+                    .parts
+                    .iter()
+                    .map(|e| parts[e.0].item.shape_cd().area())
+                    .sum();
+                (used, s)
+            })
+            .collect();
+        by_fill.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for &(_, s) in by_fill.iter().take(SQUEEZE_SHEETS) {
+            let backup = self.sheets[s].clone();
+            let c = self.least_overlap_pose(s, part, None, &Weights::default(), MOVE_SAMPLES);
+            self.put(s, part, c);
+            // The sheet was free of overlaps: the part's own are all there are.
+            let mut pairs = Pairs::new();
+            self.record_overlaps(s, part, &mut pairs);
+            if self.separate(s, rounds, pairs) {
+                let slot = self.sheets[from]
                     .parts
                     .iter()
                     .position(|e| e.0 == part)
-                    .expect("the part is on the sheet");
-                self.take_off(s, vec![slot]);
-                self.put(t, part, c);
+                    .expect("the part is on the sheet it leaves");
+                self.take_off(from, vec![slot]);
                 return true;
             }
+            self.sheets[s] = backup;
         }
         false
     }
@@ -309,31 +356,31 @@ impl Nester<'_> {
         self.checks >= self.budget || self.started.elapsed() >= self.time_limit
     }
 
-    /// Every overlapping pair on sheet `s` as (part, part, overlap), smaller part first.
-    fn overlapping_pairs(&mut self, s: usize) -> Vec<(usize, usize, f32)> {
-        let mut pairs = Vec::new();
+    /// Every overlapping pair on sheet `s`, with its overlap.
+    fn overlapping_pairs(&mut self, s: usize) -> Pairs {
+        let mut pairs = Pairs::new();
         for slot in 0..self.sheets[s].parts.len() {
             let (part, key, _) = self.sheets[s].parts[slot];
             for (other, overlap) in self.overlaps_of(s, part, key) {
                 if part < other {
-                    pairs.push((part, other, overlap));
+                    pairs.insert((part, other), overlap);
                 }
             }
         }
-        pairs.sort_by_key(|p| (p.0, p.1));
         pairs
     }
 
-    /// Whether `part` (placed on sheet `s`) overlaps another.
-    fn overlaps_any(&mut self, s: usize, part: usize) -> bool {
-        let Some(&(_, key, _)) = self.sheets[s].parts.iter().find(|e| e.0 == part) else {
-            return false;
-        };
-        self.collect_collisions_of(s, key);
-        self.overlap.collector.iter().any(|(_, e)| match e {
-            BasicHazardEntity::PlacedItem { pk, .. } => *pk != key,
-            _ => true,
-        })
+    /// Adds the pairs that `part` (placed on sheet `s`) overlaps in.
+    fn record_overlaps(&mut self, s: usize, part: usize, pairs: &mut Pairs) {
+        let key = self.sheets[s]
+            .parts
+            .iter()
+            .find(|e| e.0 == part)
+            .expect("the part is on the sheet")
+            .1;
+        for (other, overlap) in self.overlaps_of(s, part, key) {
+            pairs.insert((part.min(other), part.max(other)), overlap);
+        }
     }
 
     /// Fills the collector with what the part placed under `key` on sheet `s`
@@ -357,15 +404,30 @@ impl Nester<'_> {
         let scratch = &mut self.overlap;
         pose_discs(&parts[part].discs, &transform, &mut scratch.mine);
         let mut found = Vec::new();
+        let mut disc_pairs = 0;
         for (_, entity) in scratch.collector.iter() {
             if let BasicHazardEntity::PlacedItem { id, dt, pk } = entity {
                 if *pk != key {
                     pose_discs(&parts[*id].discs, &dt.compose(), &mut scratch.theirs);
-                    found.push((*id, disc_overlap(&scratch.mine, &scratch.theirs)));
+                    disc_pairs += scratch.mine.len() * scratch.theirs.len();
+                    let loss = pair_loss(
+                        &scratch.mine,
+                        &scratch.theirs,
+                        parts[part].scale,
+                        parts[*id].scale,
+                    );
+                    found.push((*id, loss));
                 }
             }
         }
+        self.count_evaluation(disc_pairs);
         found
+    }
+
+    /// Counts one evaluation of overlap that weighed `disc_pairs` disc pairs in the
+    /// effort budget (see the module documentation).
+    fn count_evaluation(&mut self, disc_pairs: usize) {
+        self.checks += OVERLAP_CHECK_COST + (disc_pairs / DISC_PAIRS_PER_CHECK) as u64;
     }
 
     /// Weighted overlap of `part` at `c` on sheet `s` (where it is not placed);
@@ -378,7 +440,6 @@ impl Nester<'_> {
         weights: &Weights,
         cap: f32,
     ) -> f32 {
-        self.checks += 1;
         let parts = self.parts;
         let transform = self.pose(part, c).compose();
         let shape = parts[part].item.shape_cd();
@@ -395,15 +456,24 @@ impl Nester<'_> {
             &mut scratch.collector,
         );
         if scratch.collector.is_empty() {
+            self.count_evaluation(0);
             return 0.0;
         }
+        let mut disc_pairs = 0;
         pose_discs(&parts[part].discs, &transform, &mut scratch.mine);
         let mut total = 0.0;
         for (_, entity) in scratch.collector.iter() {
             total += match entity {
                 BasicHazardEntity::PlacedItem { id, dt, .. } => {
                     pose_discs(&parts[*id].discs, &dt.compose(), &mut scratch.theirs);
-                    weights.get(part, *id) * disc_overlap(&scratch.mine, &scratch.theirs)
+                    disc_pairs += scratch.mine.len() * scratch.theirs.len();
+                    let loss = pair_loss(
+                        &scratch.mine,
+                        &scratch.theirs,
+                        parts[part].scale,
+                        parts[*id].scale,
+                    );
+                    weights.get(part, *id) * loss
                 }
                 _ => OUTSIDE,
             };
@@ -411,6 +481,7 @@ impl Nester<'_> {
                 break;
             }
         }
+        self.count_evaluation(disc_pairs);
         total
     }
 
@@ -423,7 +494,7 @@ impl Nester<'_> {
             .expect("the part is on the sheet");
         let (_, key, current) = self.sheets[s].parts[slot];
         self.sheets[s].layout.remove_item(key);
-        let c = self.least_overlap_pose(s, part, Some(current), weights);
+        let c = self.least_overlap_pose(s, part, Some(current), weights, MOVE_SAMPLES);
         let pose = self.pose(part, c);
         let key = self.sheets[s]
             .layout
@@ -440,13 +511,14 @@ impl Nester<'_> {
         part: usize,
         current: Option<Candidate>,
         weights: &Weights,
+        samples: usize,
     ) -> Candidate {
         let n_orient = self.parts[part].orientations.len();
         let reach = 0.5 * self.parts[part].item.shape_cd().diameter();
         let b = self.bounds;
         let mut best: Option<(f32, Candidate)> =
             current.map(|c| (self.weighted_overlap(s, part, c, weights, f32::INFINITY), c));
-        for k in 0..MOVE_SAMPLES {
+        for k in 0..samples {
             if best.is_some_and(|(cost, _)| cost == 0.0) {
                 break;
             }
@@ -588,22 +660,34 @@ mod tests {
             }
             discs
         };
+        let scale = LossScale {
+            diameter: 28.0,
+            hull_root: 20.0,
+        };
         let a = square(0.0);
         let mut last = f32::INFINITY;
-        for step in 0..10 {
-            let overlap = disc_overlap(&a, &square(2.0 * step as f32));
-            assert!(overlap < last, "not shrinking at step {step}: {overlap}");
-            last = overlap;
+        // Overlapping, then apart: the loss keeps shrinking, so a part that only
+        // touches its neighbour still knows which way is out.
+        for step in 0..30 {
+            let loss = pair_loss(&a, &square(2.0 * step as f32), scale, scale);
+            assert!(loss < last, "not shrinking at step {step}: {loss}");
+            last = loss;
         }
-        // Touching outlines with no overlapping discs still cost the floor.
-        assert_eq!(disc_overlap(&a, &square(40.0)), FLOOR * 100.0);
+        // Never below the floor of epsilon (0.28 mm) times the hull factor.
+        assert!(last > 0.28 * 20.0, "{last}");
+        // Symmetric, so a pair's overlap does not depend on which part was moved.
+        let b = square(7.0);
+        assert_eq!(
+            pair_loss(&a, &b, scale, scale),
+            pair_loss(&b, &a, scale, scale)
+        );
     }
 
     /// Eight 80 mm squares on a 300 mm sheet, the middle row of two placed so that
-    /// no 80 mm square is free; the ninth is alone on a second sheet. Taking that
-    /// sheet away needs the middle row rearranged.
+    /// no 80 mm square is free; the ninth is alone on a second sheet. Squeezing it
+    /// into the first needs the middle row rearranged.
     #[test]
-    fn eliminating_a_sheet_rearranges_a_blocked_one() {
+    fn squeezing_a_sheet_away_rearranges_a_blocked_one() {
         let sheet = SheetSpec {
             width: 300.0,
             height: 300.0,
@@ -637,7 +721,7 @@ mod tests {
         let c = nester.clamp(8, 0, 150.0, 150.0);
         nester.put(alone, 8, c);
 
-        assert!(nester.eliminate_emptiest(500));
+        assert!(nester.squeeze_emptiest(500));
         assert_eq!(nester.sheets.len(), 1);
         let layout = &nester.sheets[0].layout;
         assert_eq!(layout.placed_items().len(), 9);
