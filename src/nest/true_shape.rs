@@ -105,7 +105,7 @@ const SQUEEZE_CHECKS: u64 = 5_000_000;
 /// ones (spot quad-edge: 278, a 5 % sheet).
 const SQUEEZE_PARTS: usize = 2;
 
-/// Separation rounds per sheet, per unit of effort.
+/// Separation rounds per squeezed part and sheet tried, per unit of effort.
 const SEPARATION_ROUNDS: usize = 100;
 
 /// Cells of the occupancy grid along the longer side of a sheet.
@@ -239,7 +239,9 @@ pub fn true_shape_layout(
     }
     // Then squeeze the emptiest sheet's parts into the others by overlap
     // minimisation, with an allowance of its own: unlike the improvement's, it does
-    // not grow with the job, because the squeeze only ever works on one sheet's parts.
+    // not grow with the number of parts, because the squeeze only ever moves one
+    // sheet's parts (the sheets it separates are full ones, though, and there an
+    // evaluation costs up to twice what it counts).
     // A sheet of more parts is not tried: each part squeezed into a full sheet sets
     // off a cascade of moves there, and a hundred parts would take minutes.
     nester.budget = nester.checks + SQUEEZE_CHECKS * u64::from(options.effort.max(1));

@@ -2,8 +2,8 @@
 //! away, its parts go one at a time, largest first, to where they overlap least on one
 //! of the emptiest other sheets; that sheet is then separated: every overlapping part
 //! is moved to its pose of least weighted overlap, and the weight of every pair still
-//! overlapping grows (a guided local search), until nothing overlaps or the rounds or
-//! strikes run out, when the sheet is put back as it was.
+//! overlapping grows (a guided local search), until nothing overlaps, or until the
+//! rounds, strikes or budget run out, when the squeeze puts the sheet back as it was.
 //!
 //! The separation's cost is in evaluating overlap: collecting every collision of a
 //! pose, where the constructive search stops at the first, and weighing the disc
@@ -18,8 +18,8 @@
 //! discs, the penetration depth times the smaller radius, where a depth below a small
 //! epsilon (1 % of the larger part's diameter) decays smoothly instead of dropping to
 //! zero, so that two discs about to touch still count a little. The loss of a pair of
-//! parts is the square root of that sum plus epsilon squared (so every collision costs
-//! something, tab tips included), times the geometric mean of the square roots of
+//! parts is the square root of π times that sum plus epsilon squared (so every
+//! collision costs something, tab tips included), times the geometric mean of the square roots of
 //! their convex hulls' areas (large parts left overlapping cost more).
 
 use std::collections::{BTreeMap, HashMap};
@@ -53,11 +53,16 @@ const WEIGHT_GROWTH: (f32, f32) = (0.2, 1.0);
 /// Decay of a pair's weight per round it does not overlap (down to 1).
 const WEIGHT_DECAY: f32 = 0.95;
 
+/// Most weight of a pair: far above what separations reach (about 10 on the bunny),
+/// and far below the cost of a pose outside the sheet, which it must never outweigh.
+const WEIGHT_CAP: f32 = 1e6;
+
 /// Rounds without a new least total overlap after which the separation goes back to
 /// the least-overlap state it saw (a strike).
 const ROUNDS_PER_STRIKE: u32 = 50;
 
-/// Strikes in a row that did not lower the least total overlap by 2 % before a sheet
+/// Strikes in a row that did not lower the least total overlap by 2 % (against the
+/// least at the strike before: the first strike only sets that mark) before a sheet
 /// is given up.
 const STRIKES: u32 = 3;
 
@@ -181,11 +186,12 @@ fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle
 
 impl Nester<'_> {
     /// Moves the overlapping parts of sheet `s`, whose overlapping pairs are `pairs`,
-    /// until none overlaps (`true`), or until `rounds` rounds or the strikes run out
-    /// (`false`, the sheet left in the least-overlap state seen). The pairs are kept
-    /// up to date for the parts that move, never found by scanning the sheet: a sheet
-    /// of a large job holds hundreds of parts, and scanning them all every round cost
-    /// more than the moves themselves.
+    /// until none overlaps (`true`), or until `rounds` rounds, the strikes or the
+    /// budget run out (`false`, the sheet left overlapping: the caller puts it back).
+    /// The pairs are kept up to date for the parts that move; the sheet is scanned
+    /// only when they run out and the whole-sheet check still finds a collision. A
+    /// sheet of a large job holds hundreds of parts, and scanning them all every round
+    /// cost more than the moves themselves.
     fn separate(&mut self, s: usize, rounds: usize, mut pairs: Pairs) -> bool {
         let mut weights = Weights::default();
         // The least total overlap seen, and the poses and pairs in that state.
@@ -205,6 +211,11 @@ impl Nester<'_> {
                     return true;
                 }
                 pairs = self.overlapping_pairs(s);
+                if pairs.is_empty() {
+                    // What collides is a part with the sheet's edge, which moves
+                    // do not track: give up rather than scan again every round.
+                    return false;
+                }
             }
             if self.out_of_budget() {
                 break;
@@ -244,7 +255,7 @@ impl Nester<'_> {
                 let w = weights.0.entry((a, b)).or_insert(1.0);
                 let growth = grow_least + (grow_most - grow_least) * overlap / largest;
                 // Undo this round's decay, then grow.
-                *w = (*w / WEIGHT_DECAY).max(1.0) * (1.0 + growth);
+                *w = ((*w / WEIGHT_DECAY).max(1.0) * (1.0 + growth)).min(WEIGHT_CAP);
             }
             let mut movers: Vec<usize> = pairs.keys().flat_map(|&(a, b)| [a, b]).collect();
             movers.sort_unstable();
@@ -263,11 +274,6 @@ impl Nester<'_> {
                 self.record_overlaps(s, part, &mut pairs);
             }
         }
-        // Given up: leave the least-overlap state (the caller restores or retries).
-        if let Some((poses, _)) = least_state {
-            self.restore_poses(s, &poses);
-        }
-        self.refill_grid(s);
         false
     }
 
@@ -331,8 +337,11 @@ impl Nester<'_> {
             .collect();
         by_fill.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         for &(_, s) in by_fill.iter().take(SQUEEZE_SHEETS) {
+            if self.out_of_budget() {
+                break;
+            }
             let backup = self.sheets[s].clone();
-            let c = self.least_overlap_pose(s, part, None, &Weights::default(), MOVE_SAMPLES);
+            let c = self.least_overlap_pose(s, part, None, &Weights::default());
             self.put(s, part, c);
             // The sheet was free of overlaps: the part's own are all there are.
             let mut pairs = Pairs::new();
@@ -351,7 +360,8 @@ impl Nester<'_> {
         false
     }
 
-    /// Whether the improvement has spent its collision checks or time.
+    /// Whether the current phase (improvement or squeeze) has spent its collision
+    /// checks, or the improvement and squeeze together their time.
     pub(super) fn out_of_budget(&self) -> bool {
         self.checks >= self.budget || self.started.elapsed() >= self.time_limit
     }
@@ -494,7 +504,7 @@ impl Nester<'_> {
             .expect("the part is on the sheet");
         let (_, key, current) = self.sheets[s].parts[slot];
         self.sheets[s].layout.remove_item(key);
-        let c = self.least_overlap_pose(s, part, Some(current), weights, MOVE_SAMPLES);
+        let c = self.least_overlap_pose(s, part, Some(current), weights);
         let pose = self.pose(part, c);
         let key = self.sheets[s]
             .layout
@@ -511,14 +521,13 @@ impl Nester<'_> {
         part: usize,
         current: Option<Candidate>,
         weights: &Weights,
-        samples: usize,
     ) -> Candidate {
         let n_orient = self.parts[part].orientations.len();
         let reach = 0.5 * self.parts[part].item.shape_cd().diameter();
         let b = self.bounds;
         let mut best: Option<(f32, Candidate)> =
             current.map(|c| (self.weighted_overlap(s, part, c, weights, f32::INFINITY), c));
-        for k in 0..samples {
+        for k in 0..MOVE_SAMPLES {
             if best.is_some_and(|(cost, _)| cost == 0.0) {
                 break;
             }
