@@ -29,9 +29,9 @@ use jagua_rs::collision_detection::hazards::filter::NoFilter;
 use jagua_rs::collision_detection::hazards::{BasicHazardEntity, PItemKey};
 use jagua_rs::geometry::geo_traits::{CollidesWith, DistanceTo, Transformable, TransformableFrom};
 use jagua_rs::geometry::primitives::{Circle, Point, SPolygon};
-use jagua_rs::geometry::Transformation;
+use jagua_rs::geometry::{DTransformation, Transformation};
 
-use super::{Candidate, Nester, MIN_STEP};
+use super::{Candidate, Nester, Part, MIN_STEP};
 
 /// Most lattice points of a part's bounds tried as disc centres.
 const LATTICE_POINTS: usize = 400;
@@ -175,8 +175,41 @@ impl Weights {
 #[derive(Default)]
 pub(super) struct OverlapScratch {
     collector: BasicHazardCollector,
+    discs: PosedDiscs,
+}
+
+/// The discs of the part being evaluated and of one it collides with, posed.
+#[derive(Default)]
+struct PosedDiscs {
     mine: Vec<Circle>,
     theirs: Vec<Circle>,
+}
+
+impl PosedDiscs {
+    /// Poses the discs of `part` (the one evaluated) by `transform`.
+    fn pose_mine(&mut self, parts: &[Part], part: usize, transform: &Transformation) {
+        pose_discs(&parts[part].discs, transform, &mut self.mine);
+    }
+
+    /// Overlap loss of `part`, whose discs [`PosedDiscs::pose_mine`] posed, with
+    /// `other` placed at `placed`; adds the disc pairs weighed to `disc_pairs`.
+    fn loss_with(
+        &mut self,
+        parts: &[Part],
+        part: usize,
+        other: usize,
+        placed: &DTransformation,
+        disc_pairs: &mut usize,
+    ) -> f32 {
+        pose_discs(&parts[other].discs, &placed.compose(), &mut self.theirs);
+        *disc_pairs += self.mine.len() * self.theirs.len();
+        pair_loss(
+            &self.mine,
+            &self.theirs,
+            parts[part].scale,
+            parts[other].scale,
+        )
+    }
 }
 
 fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle>) {
@@ -412,20 +445,15 @@ impl Nester<'_> {
             .d_transf()
             .compose();
         let scratch = &mut self.overlap;
-        pose_discs(&parts[part].discs, &transform, &mut scratch.mine);
+        scratch.discs.pose_mine(parts, part, &transform);
         let mut found = Vec::new();
         let mut disc_pairs = 0;
         for (_, entity) in scratch.collector.iter() {
             if let BasicHazardEntity::PlacedItem { id, dt, pk } = entity {
                 if *pk != key {
-                    pose_discs(&parts[*id].discs, &dt.compose(), &mut scratch.theirs);
-                    disc_pairs += scratch.mine.len() * scratch.theirs.len();
-                    let loss = pair_loss(
-                        &scratch.mine,
-                        &scratch.theirs,
-                        parts[part].scale,
-                        parts[*id].scale,
-                    );
+                    let loss = scratch
+                        .discs
+                        .loss_with(parts, part, *id, dt, &mut disc_pairs);
                     found.push((*id, loss));
                 }
             }
@@ -470,19 +498,14 @@ impl Nester<'_> {
             return 0.0;
         }
         let mut disc_pairs = 0;
-        pose_discs(&parts[part].discs, &transform, &mut scratch.mine);
+        scratch.discs.pose_mine(parts, part, &transform);
         let mut total = 0.0;
         for (_, entity) in scratch.collector.iter() {
             total += match entity {
                 BasicHazardEntity::PlacedItem { id, dt, .. } => {
-                    pose_discs(&parts[*id].discs, &dt.compose(), &mut scratch.theirs);
-                    disc_pairs += scratch.mine.len() * scratch.theirs.len();
-                    let loss = pair_loss(
-                        &scratch.mine,
-                        &scratch.theirs,
-                        parts[part].scale,
-                        parts[*id].scale,
-                    );
+                    let loss = scratch
+                        .discs
+                        .loss_with(parts, part, *id, dt, &mut disc_pairs);
                     weights.get(part, *id) * loss
                 }
                 _ => OUTSIDE,
