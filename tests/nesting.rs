@@ -5,7 +5,10 @@
 
 mod common;
 
+use std::path::Path;
+
 use glam::DVec2;
+use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
@@ -253,31 +256,41 @@ fn sheets_come_fullest_first_and_their_fills_add_up() {
     }
 }
 
+/// Builds `model` with `args` into `out` on `threads` threads, checks every sheet,
+/// and returns the manifest.
+fn build_on_threads(model: &Path, args: &[&str], out: &Path, threads: &str) -> Value {
+    let mut cmd = unfold_command();
+    cmd.arg(model)
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .env("RAYON_NUM_THREADS", threads);
+    let run = finish(&mut cmd);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let m = common::build::read_manifest(out);
+    check_sheets(out, &m, DxfCheck::FirstAndLast);
+    m
+}
+
 #[test]
 fn a_seed_gives_the_same_bytes_with_one_or_two_threads() {
     let tmp = TempDir::new().unwrap();
     let mut outputs = Vec::new();
     for (label, seed, threads) in [("a", "7", "1"), ("b", "7", "2"), ("c", "8", "2")] {
         let out = tmp.path().join(label);
-        let mut cmd = unfold_command();
-        cmd.arg(model("genus3"))
-            .args([
-                "--scheme",
-                "quad-edge",
-                "--size",
-                "12in",
-                "--seed",
-                seed,
-                "--effort",
-                "2",
-            ])
-            .args(["--format", "svg,dxf", "--out"])
-            .arg(&out)
-            .env("RAYON_NUM_THREADS", threads);
-        let run = finish(&mut cmd);
-        assert_eq!(run.code, Some(0), "{}", run.stderr);
-        let m = common::build::read_manifest(&out);
-        check_sheets(&out, &m, DxfCheck::FirstAndLast);
+        let args = [
+            "--scheme",
+            "quad-edge",
+            "--size",
+            "12in",
+            "--seed",
+            seed,
+            "--effort",
+            "2",
+            "--format",
+            "svg,dxf",
+        ];
+        let m = build_on_threads(&model("genus3"), &args, &out, threads);
         assert_eq!(count(&m, "nesting.seed"), seed.parse::<usize>().unwrap());
         outputs.push(folder_files(&out));
     }
@@ -350,16 +363,17 @@ fn the_squeeze_takes_the_bunnys_last_sheet_away_at_two_mm_spacing() {
     let mut outputs = Vec::new();
     for threads in ["1", "2"] {
         let out = tmp.path().join(threads);
-        let mut cmd = unfold_command();
-        cmd.arg(dir.join("stanford-bunny.obj"))
-            .args(["--target-edges", "625", "--scheme", "quad-edge"])
-            .args(["--size", "4ft", "--spacing", "2mm", "--out"])
-            .arg(&out)
-            .env("RAYON_NUM_THREADS", threads);
-        let run = finish(&mut cmd);
-        assert_eq!(run.code, Some(0), "{}", run.stderr);
-        let m = common::build::read_manifest(&out);
-        check_sheets(&out, &m, DxfCheck::FirstAndLast);
+        let args = [
+            "--target-edges",
+            "625",
+            "--scheme",
+            "quad-edge",
+            "--size",
+            "4ft",
+            "--spacing",
+            "2mm",
+        ];
+        let m = build_on_threads(&dir.join("stanford-bunny.obj"), &args, &out, threads);
         let sheets = count(&m, "counts.sheets");
         assert!(sheets <= 12, "{sheets} sheets, the squeeze took none away");
         outputs.push(folder_files(&out));

@@ -19,8 +19,8 @@
 //! epsilon (1 % of the larger part's diameter) decays smoothly instead of dropping to
 //! zero, so that two discs about to touch still count a little. The loss of a pair of
 //! parts is the square root of π times that sum plus epsilon squared (so every
-//! collision costs something, tab tips included), times the geometric mean of the square roots of
-//! their convex hulls' areas (large parts left overlapping cost more).
+//! collision costs something, tab tips included), times the geometric mean of the
+//! square roots of their convex hulls' areas (large parts left overlapping cost more).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -137,9 +137,9 @@ pub(super) struct LossScale {
 }
 
 /// Overlap loss of two posed parts (their discs and scales): see the module
-/// documentation. Every pair of discs counts, however far
-/// apart: the decayed terms of discs that are close but apart are what tells two parts
-/// that only touch at their outlines how to move apart.
+/// documentation. Every pair of discs counts, however far apart: the decayed terms of
+/// discs that are close but apart are what tells two parts that only touch at their
+/// outlines how to move apart.
 fn pair_loss(a: &[Circle], b: &[Circle], sa: LossScale, sb: LossScale) -> f32 {
     let eps = EPSILON_SHARE * sa.diameter.max(sb.diameter);
     let mut total = 0.0;
@@ -323,12 +323,28 @@ impl Nester<'_> {
             if (now.orientation, now.x, now.y) == (c.orientation, c.x, c.y) {
                 continue;
             }
-            let pose = self.pose(part, c);
-            let layout = &mut self.sheets[s].layout;
-            layout.remove_item(key);
-            let key = layout.place_item(&self.parts[part].item, pose);
-            self.sheets[s].parts[slot] = (part, key, c);
+            self.sheets[s].layout.remove_item(key);
+            self.place_in_slot(s, slot, part, c);
         }
+    }
+
+    /// Places `part`, taken out of the layout of sheet `s`, back at `c`, and records
+    /// its new key and pose in its slot.
+    fn place_in_slot(&mut self, s: usize, slot: usize, part: usize, c: Candidate) {
+        let pose = self.pose(part, c);
+        let key = self.sheets[s]
+            .layout
+            .place_item(&self.parts[part].item, pose);
+        self.sheets[s].parts[slot] = (part, key, c);
+    }
+
+    /// The slot of `part` on sheet `s`, where it is placed.
+    fn slot_of(&self, s: usize, part: usize) -> usize {
+        self.sheets[s]
+            .parts
+            .iter()
+            .position(|e| e.0 == part)
+            .expect("the part is on the sheet")
     }
 
     /// Squeezes the parts of the emptiest sheet, largest first, into the others one at
@@ -380,11 +396,7 @@ impl Nester<'_> {
             let mut pairs = Pairs::new();
             self.record_overlaps(s, part, &mut pairs);
             if self.separate(s, rounds, pairs) {
-                let slot = self.sheets[from]
-                    .parts
-                    .iter()
-                    .position(|e| e.0 == part)
-                    .expect("the part is on the sheet it leaves");
+                let slot = self.slot_of(from, part);
                 self.take_off(from, vec![slot]);
                 return true;
             }
@@ -415,12 +427,7 @@ impl Nester<'_> {
 
     /// Adds the pairs that `part` (placed on sheet `s`) overlaps in.
     fn record_overlaps(&mut self, s: usize, part: usize, pairs: &mut Pairs) {
-        let key = self.sheets[s]
-            .parts
-            .iter()
-            .find(|e| e.0 == part)
-            .expect("the part is on the sheet")
-            .1;
+        let key = self.sheets[s].parts[self.slot_of(s, part)].1;
         for (other, overlap) in self.overlaps_of(s, part, key) {
             pairs.insert((part.min(other), part.max(other)), overlap);
         }
@@ -520,19 +527,11 @@ impl Nester<'_> {
 
     /// Moves a placed part of sheet `s` to its pose of least weighted overlap.
     fn move_part(&mut self, s: usize, part: usize, weights: &Weights) {
-        let slot = self.sheets[s]
-            .parts
-            .iter()
-            .position(|e| e.0 == part)
-            .expect("the part is on the sheet");
+        let slot = self.slot_of(s, part);
         let (_, key, current) = self.sheets[s].parts[slot];
         self.sheets[s].layout.remove_item(key);
         let c = self.least_overlap_pose(s, part, Some(current), weights);
-        let pose = self.pose(part, c);
-        let key = self.sheets[s]
-            .layout
-            .place_item(&self.parts[part].item, pose);
-        self.sheets[s].parts[slot] = (part, key, c);
+        self.place_in_slot(s, slot, part, c);
     }
 
     /// The pose of least weighted overlap of `part` (not placed) on sheet `s`:
