@@ -249,6 +249,13 @@ pub struct ModelOptions {
     #[arg(long, value_name = "N")]
     pub target_faces: Option<usize>,
 
+    /// What simplification favours: regular (even triangle sizes and shapes, so
+    /// panels of one size that nest tightly) or accurate (the closest surface: few
+    /// large triangles where the model is flat, many small ones where it curves).
+    /// [default: regular]
+    #[arg(long, value_name = "MODE")]
+    pub simplify_mode: Option<crate::mesh::simplify::SimplifyMode>,
+
     /// Remove connected components with fewer than N faces (stray fragments of a scan,
     /// loose parts too small to build). [default: 0, keep every component]
     #[arg(long, value_name = "N")]
@@ -339,6 +346,8 @@ pub struct ModelSettings {
     pub planarity_tol: f64,
     /// Simplification budget, if any.
     pub budget: Option<crate::mesh::simplify::Budget>,
+    /// What simplification favours.
+    pub simplify_mode: crate::mesh::simplify::SimplifyMode,
     /// Components with fewer faces than this are removed (0 keeps all).
     pub min_component: usize,
 }
@@ -354,6 +363,7 @@ impl ModelOptions {
             planarity_tol: self.planarity_tol.or(other.planarity_tol),
             target_edges: self.target_edges.or(other.target_edges),
             target_faces: self.target_faces.or(other.target_faces),
+            simplify_mode: self.simplify_mode.or(other.simplify_mode),
             min_component: self.min_component.or(other.min_component),
         }
     }
@@ -399,6 +409,7 @@ impl ModelOptions {
         };
         Ok(ModelSettings {
             budget,
+            simplify_mode: self.simplify_mode.unwrap_or_default(),
             min_component: self.min_component.unwrap_or(0),
             scaling: Scaling {
                 size,

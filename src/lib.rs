@@ -51,8 +51,16 @@ pub fn load_model(
         drop_small_components(path, settings.min_component, &mut prepared)?;
     }
     if let Some(budget) = settings.budget {
-        let (simplified, report) = mesh::simplify::simplify(&prepared.mesh, budget)
-            .map_err(|e| InputError::new(path, error::Location::File, e.to_string(), ""))?;
+        let (simplified, report) =
+            mesh::simplify::simplify(&prepared.mesh, budget, settings.simplify_mode)
+                .map_err(|e| InputError::new(path, error::Location::File, e.to_string(), ""))?;
+        let mode = match report.fallback {
+            None => format!("{} mode", settings.simplify_mode),
+            Some(used) => format!(
+                "{} mode changed the topology, so {used}",
+                settings.simplify_mode
+            ),
+        };
         let message = if report.before == report.after {
             format!(
                 "{} faces and {} edges are already within the budget; not simplified",
@@ -60,8 +68,8 @@ pub fn load_model(
             )
         } else {
             format!(
-                "simplified from {} faces and {} edges to {} faces and {} edges; largest deviation from the original surface {:.3e} model units (measured at every original vertex and triangle centre)",
-                report.before.0, report.before.1, report.after.0, report.after.1, report.deviation
+                "simplified from {} faces and {} edges to {} faces and {} edges ({}; longest edge {:.1} times the median); largest deviation from the original surface {:.3e} model units (measured at every original vertex and triangle centre)",
+                report.before.0, report.before.1, report.after.0, report.after.1, mode, report.edge_spread, report.deviation
             )
         };
         prepared.notes.push(Note {

@@ -232,3 +232,59 @@ fn the_deviation_is_measured() {
         "{fine} {coarse}"
     );
 }
+
+/// The `simplified` note's text.
+fn simplified_note(path: &std::path::Path, options: &[&str]) -> String {
+    let report = inspect_json(path, options);
+    report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["kind"] == "simplified")
+        .and_then(|n| n["message"].as_str())
+        .unwrap_or_else(|| panic!("no simplified note: {report}"))
+        .to_string()
+}
+
+/// The longest edge over the median one, as the note gives it.
+fn edge_spread(note: &str) -> f64 {
+    let tail = note
+        .split("longest edge ")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{note}"));
+    tail.split(' ').next().unwrap().parse().unwrap()
+}
+
+/// Regular mode (the default) evens the edges, so panels come out alike; accurate
+/// mode keeps large triangles where the model is flat. Where regularizing would change
+/// the topology, the note says which simplification was used instead, and the genus
+/// holds.
+#[test]
+fn regular_mode_evens_the_edges() {
+    let Some(shared) = shared_models("regular_mode_evens_the_edges") else {
+        return;
+    };
+    for name in ["stanford-bunny.obj", "spot.obj"] {
+        let path = shared.join(name);
+        let regular = simplified_note(&path, &["--target-edges", "625"]);
+        let accurate = simplified_note(
+            &path,
+            &["--target-edges", "625", "--simplify-mode", "accurate"],
+        );
+        assert!(regular.contains("(regular mode;"), "{regular}");
+        assert!(accurate.contains("(accurate mode;"), "{accurate}");
+        let (even, uneven) = (edge_spread(&regular), edge_spread(&accurate));
+        assert!(
+            even <= 2.5 && uneven >= 3.0,
+            "{name}: longest edge {even} (regular) and {uneven} (accurate) times the median"
+        );
+    }
+    let fertility = shared.join("fertility.obj");
+    let note = simplified_note(&fertility, &["--target-edges", "600"]);
+    assert!(
+        note.contains("regular mode changed the topology, so lightly regularized"),
+        "{note}"
+    );
+    let report = inspect_json(&fertility, &["--target-edges", "600"]);
+    assert_eq!(count(&report, "mesh.genus"), 4, "{report}");
+}
