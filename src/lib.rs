@@ -57,7 +57,7 @@ pub fn load_model(
         let mode = match report.fallback {
             None => format!("{} mode", settings.simplify_mode),
             Some(used) => format!(
-                "{} mode changed the topology, so {used}",
+                "{} mode did not keep the topology, so {used} was used",
                 settings.simplify_mode
             ),
         };

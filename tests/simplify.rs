@@ -29,10 +29,17 @@ fn simplified(path: &std::path::Path, budget: &[&str]) -> (usize, usize, usize, 
 #[test]
 fn topology_is_kept_on_the_project_models() {
     for (name, genus) in [("genus2", 2), ("genus3", 3)] {
-        // Their 50/68 quads become 100/136 triangles first; 150 edges is a real cut.
-        let (edges, _, g, loops) = simplified(&model(name), &["--target-edges", "150"]);
-        assert_eq!((g, loops), (genus, 0), "{name}");
-        assert!(edges <= 153, "{name}: {edges} edges");
+        for mode in ["regular", "accurate"] {
+            // Their 50/68 quads become 100/136 triangles first; 150 edges is a real cut.
+            let budget = ["--target-edges", "150", "--simplify-mode", mode];
+            let (edges, _, g, loops) = simplified(&model(name), &budget);
+            assert_eq!((g, loops), (genus, 0), "{name}, {mode} mode");
+            assert!(edges <= 153, "{name}, {mode} mode: {edges} edges");
+            // genus2's 150 triangle edges are already within the budget.
+            let note = simplified_note(&model(name), &budget);
+            let cut = name == "genus3";
+            assert_eq!(note.contains(&format!("({mode} mode;")), cut, "{note}");
+        }
     }
     // A budget above the model's size leaves it alone.
     let report = inspect_json(&model("genus2"), &["--target-faces", "100000"]);
@@ -44,15 +51,19 @@ fn topology_is_kept_on_the_shared_models() {
     let Some(shared) = shared_models("topology_is_kept_on_the_shared_models") else {
         return;
     };
-    for (name, budget, genus, loops) in [
-        ("spot.obj", "600", 0, 0),
-        ("spot.obj", "150", 0, 0),
-        ("stanford-bunny.obj", "625", 0, 5),
-        ("stanford-bunny.obj", "1500", 0, 5),
-        ("fertility.obj", "600", 4, 0),
+    for (name, budget, genus, loops, mode) in [
+        ("spot.obj", "600", 0, 0, "regular"),
+        ("spot.obj", "150", 0, 0, "regular"),
+        ("spot.obj", "150", 0, 0, "accurate"),
+        ("stanford-bunny.obj", "625", 0, 5, "regular"),
+        ("stanford-bunny.obj", "625", 0, 5, "accurate"),
+        ("stanford-bunny.obj", "1500", 0, 5, "regular"),
+        ("fertility.obj", "600", 4, 0, "regular"),
+        ("fertility.obj", "600", 4, 0, "accurate"),
     ] {
-        let what = format!("{name} to {budget} edges");
-        let (edges, faces, g, l) = simplified(&shared.join(name), &["--target-edges", budget]);
+        let what = format!("{name} to {budget} edges, {mode} mode");
+        let options = ["--target-edges", budget, "--simplify-mode", mode];
+        let (edges, faces, g, l) = simplified(&shared.join(name), &options);
         assert_eq!((g, l), (genus, loops), "{what}: genus, boundary loops");
         let wanted: usize = budget.parse().unwrap();
         assert!(
@@ -219,8 +230,10 @@ fn the_deviation_is_measured() {
     }
     let grid = tmp.path().join("flat.obj");
     std::fs::write(&grid, obj).unwrap();
-    let flat = reported_deviation(&grid, &["--target-faces", "20"]);
-    assert!(flat < 1e-9, "flat grid: {flat}");
+    for mode in ["regular", "accurate"] {
+        let flat = reported_deviation(&grid, &["--target-faces", "20", "--simplify-mode", mode]);
+        assert!(flat < 1e-9, "flat grid, {mode} mode: {flat}");
+    }
     // A curved surface moves, more for a smaller budget, and by a small part of its
     // size (spot is 0.94 x 1.69 x 1.72 units; at 150 edges it keeps about 100
     // triangles, so ears and horns move by a tenth of a unit).
@@ -282,12 +295,17 @@ fn regular_mode_evens_the_edges() {
             "{name}: longest edge {even} (regular) and {uneven} (accurate) times the median"
         );
     }
-    let fertility = shared.join("fertility.obj");
-    let note = simplified_note(&fertility, &["--target-edges", "600"]);
+    let report = inspect_json(&shared.join("fertility.obj"), &["--target-edges", "600"]);
+    let note = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|n| n["kind"] == "simplified")
+        .and_then(|n| n["message"].as_str())
+        .unwrap_or_else(|| panic!("no simplified note: {report}"));
     assert!(
-        note.contains("regular mode changed the topology, so lightly regularized"),
+        note.contains("regular mode did not keep the topology, so light regularization was used"),
         "{note}"
     );
-    let report = inspect_json(&fertility, &["--target-edges", "600"]);
     assert_eq!(count(&report, "mesh.genus"), 4, "{report}");
 }
