@@ -250,7 +250,7 @@ pub struct ModelOptions {
     pub target_faces: Option<usize>,
 
     /// What simplification favours: regular (even triangle sizes and shapes, so
-    /// panels of one size that nest tightly) or accurate (the closest surface: few
+    /// panels of one size) or accurate (the closest surface: few
     /// large triangles where the model is flat, many small ones where it curves).
     /// [default: regular]
     #[arg(long, value_name = "MODE")]

@@ -185,15 +185,7 @@ fn small_components_are_removed() {
 
 /// The deviation the `simplified` note reports (model units).
 fn reported_deviation(path: &std::path::Path, budget: &[&str]) -> f64 {
-    let report = inspect_json(path, budget);
-    let note = report["notes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|n| n["kind"] == "simplified")
-        .and_then(|n| n["message"].as_str())
-        .expect("a simplified note")
-        .to_string();
+    let note = simplified_note(path, budget);
     let tail = note
         .split("original surface ")
         .nth(1)
@@ -249,9 +241,8 @@ fn the_deviation_is_measured() {
     );
 }
 
-/// The `simplified` note's text.
-fn simplified_note(path: &std::path::Path, options: &[&str]) -> String {
-    let report = inspect_json(path, options);
+/// The `simplified` note's text in an `inspect --json` report.
+fn note_in(report: &serde_json::Value) -> String {
     report["notes"]
         .as_array()
         .unwrap()
@@ -260,6 +251,11 @@ fn simplified_note(path: &std::path::Path, options: &[&str]) -> String {
         .and_then(|n| n["message"].as_str())
         .unwrap_or_else(|| panic!("no simplified note: {report}"))
         .to_string()
+}
+
+/// The `simplified` note's text for a model and options.
+fn simplified_note(path: &std::path::Path, options: &[&str]) -> String {
+    note_in(&inspect_json(path, options))
 }
 
 /// The longest edge over the median one, as the note gives it.
@@ -296,13 +292,7 @@ fn regular_mode_evens_the_edges() {
         );
     }
     let report = inspect_json(&shared.join("fertility.obj"), &["--target-edges", "600"]);
-    let note = report["notes"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|n| n["kind"] == "simplified")
-        .and_then(|n| n["message"].as_str())
-        .unwrap_or_else(|| panic!("no simplified note: {report}"));
+    let note = note_in(&report);
     assert!(
         note.contains("regular mode did not keep the topology, so light regularization was used"),
         "{note}"

@@ -194,6 +194,12 @@ impl Mesh {
         (self.origin(h), self.dest(h))
     }
 
+    /// The length of an edge.
+    pub fn edge_length(&self, e: EdgeId) -> f64 {
+        let (a, b) = self.edge_vertices(e);
+        self.position(a).distance(self.position(b))
+    }
+
     /// The half-edges of a face, counter-clockwise from its stored half-edge.
     pub fn face_half_edges(&self, f: FaceId) -> LoopIter<'_> {
         self.loop_from(self.face_half_edge(f))

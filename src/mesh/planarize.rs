@@ -236,8 +236,7 @@ pub fn planarize(
 /// Mean length of the mesh's edges.
 fn mean_edge_length(mesh: &Mesh) -> f64 {
     let (sum, count) = mesh.edges().fold((0.0, 0usize), |(sum, count), e| {
-        let (a, b) = mesh.edge_vertices(e);
-        (sum + mesh.position(a).distance(mesh.position(b)), count + 1)
+        (sum + mesh.edge_length(e), count + 1)
     });
     if count == 0 {
         1.0

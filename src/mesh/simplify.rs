@@ -25,9 +25,10 @@ pub enum Budget {
 pub enum SimplifyMode {
     /// Even triangle sizes and shapes (meshoptimizer's `Regularize`), at some cost in
     /// closeness to the original surface. Every edge becomes a panel, so even edges
-    /// make panels of one size that assemble alike and nest tightly: the bunny at 625
-    /// edges has its longest edge 2.0 times the median instead of 3.4, and quad-edge at
-    /// 4 ft its outlines grown by half the spacing fit 10 sheets instead of 11.
+    /// make panels of one size that assemble alike and lose less to the spacing: the
+    /// bunny at 625 edges has its longest edge 2.0 times the median instead of 3.4,
+    /// and quad-edge at 4 ft its outlines grown by half the spacing fit 10 sheets
+    /// instead of 11.
     #[default]
     Regular,
     /// The closest surface for the budget: flat regions keep few, large triangles and
@@ -197,8 +198,13 @@ impl Input<'_> {
         &self,
         options: meshopt::SimplifyOptions,
     ) -> Result<(Mesh, SimplifyReport), SimplifyError> {
-        let (mesh, indices, budget) = (self.mesh, self.indices, self.budget);
-        let before = &self.before;
+        self.rebuild(&self.simplified_triangles(options))
+    }
+
+    /// The simplifier's triangles for `options`, its target corrected a few times
+    /// toward an edge budget.
+    fn simplified_triangles(&self, options: meshopt::SimplifyOptions) -> Vec<u32> {
+        let (indices, budget) = (self.indices, self.budget);
         let triangles = indices.len() / 3;
         // meshoptimizer asserts (aborting the process) if asked for more triangles
         // than it has: never ask.
@@ -230,11 +236,17 @@ impl Input<'_> {
                 out = run(target);
             }
         }
+        out
+    }
 
+    /// The mesh of the simplifier's triangles `out`, refused unless it is a manifold
+    /// of the same topology, with its report.
+    fn rebuild(&self, out: &[u32]) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+        let (mesh, indices, before) = (self.mesh, self.indices, &self.before);
         // A collapse can fold two triangles onto each other (the same three vertices, once
         // each way round): that pocket encloses nothing and gives its edges four faces.
         // Remove both copies, and any triangle that lost a corner.
-        let out = drop_folded_pairs(&out);
+        let out = drop_folded_pairs(out);
         // Compact the vertices the simplified triangles still use.
         let mut new_index = vec![u32::MAX; mesh.vertex_count()];
         let mut polys = Polygons::new();
@@ -267,7 +279,7 @@ impl Input<'_> {
             });
         }
         let report = SimplifyReport {
-            before: (triangles, edge_count(indices)),
+            before: (indices.len() / 3, edge_count(indices)),
             after: (after.faces, after.edges),
             deviation: deviation(mesh.positions(), indices, &simplified),
             edge_spread: edge_spread(&simplified),
@@ -279,13 +291,7 @@ impl Input<'_> {
 
 /// The longest edge length over the median one.
 fn edge_spread(mesh: &Mesh) -> f64 {
-    let mut lengths: Vec<f64> = mesh
-        .edges()
-        .map(|e| {
-            let (a, b) = mesh.edge_vertices(e);
-            mesh.position(a).distance(mesh.position(b))
-        })
-        .collect();
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
     lengths.sort_unstable_by(f64::total_cmp);
     let median = lengths.get(lengths.len() / 2).copied().unwrap_or(0.0);
     let longest = lengths.last().copied().unwrap_or(0.0);
