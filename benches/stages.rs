@@ -14,7 +14,7 @@ use unfold::flatten::unroll_and_fit;
 use unfold::labels::LabelOptions;
 use unfold::mesh::Mesh;
 use unfold::nest::{lay_out, NestSettings, NesterName, SheetSpec};
-use unfold::panel::FlatPanel;
+use unfold::panel::{FlatPanel, FlatPanels};
 use unfold::scheme::build_panels;
 
 fn job(model: &Path, scheme: SchemeName, size: &str) -> Job {
@@ -135,7 +135,7 @@ fn nesting_and_export(c: &mut Criterion) {
         }
 
         let layout = lay_out(&outlines, &areas, sheet, &job.nest).unwrap().layout;
-        let owned: Vec<FlatPanel> = by_area.iter().map(|p| (*p).clone()).collect();
+        let owned: FlatPanels = by_area.iter().map(|p| (*p).clone()).collect();
         drawn.push((name, layout, owned, sheet));
     }
     group.finish();

@@ -41,9 +41,10 @@ fn main() -> anyhow::Result<()> {
     let mut lap = |stage: &str| {
         let now = Instant::now();
         println!(
-            "{stage:<8} {:>8.0} ms   resident {:>6} MiB",
+            "{stage:<8} {:>8.0} ms   resident {:>6} MiB   peak so far {:>6} MiB",
             (now - last).as_secs_f64() * 1e3,
-            memory_kib("VmRSS:").unwrap_or(0) / 1024
+            memory_kib("VmRSS:").unwrap_or(0) / 1024,
+            memory_kib("VmHWM:").unwrap_or(0) / 1024
         );
         last = now;
     };
@@ -59,7 +60,7 @@ fn main() -> anyhow::Result<()> {
     let (flat, _) = unroll_all(&output.panels, LabelOptions::default())?;
     lap("flatten");
     let total = start.elapsed().as_secs_f64();
-    let per_panel = |count: &dyn Fn(&unfold::panel::Panel) -> usize| {
+    let per_panel = |count: &dyn Fn(unfold::panel::PanelRef) -> usize| {
         output.panels.iter().map(count).sum::<usize>() as f64 / output.panels.len().max(1) as f64
     };
     println!(

@@ -8,11 +8,9 @@ use std::collections::VecDeque;
 
 use glam::{DVec2, DVec3};
 
-use rayon::prelude::*;
-
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
-use crate::panel::{FacetFrame, FlatHole, FlatPanel, Panel};
+use crate::panel::{make_in_order, FacetFrame, FlatHole, FlatPanel, FlatPanels, PanelRef, Panels};
 use crate::plane::loop_signed_area;
 
 /// Why a panel cannot be unrolled (a bug in the scheme that made it).
@@ -47,20 +45,20 @@ const FLAT_FOLD: f64 = 1e-9;
 
 /// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
 /// first edge along +x); every other facet is placed across a hinge.
-pub fn flatten(panel: &Panel) -> Result<FlatPanel, FlattenError> {
-    unroll(panel).map(|(flat, _)| flat)
+pub fn flatten<'a>(panel: impl Into<PanelRef<'a>>) -> Result<FlatPanel, FlattenError> {
+    unroll(panel.into()).map(|(flat, _)| flat)
 }
 
 /// The isometry of every facet of `panel` between 3D and the flat panel that
 /// [`flatten`] makes of it: the flat panel's map back to 3D for any point (a hole, a
 /// label). Flat panels do not keep it (a million panels would carry a hundred bytes
 /// per facet for it), so it is computed again, by the same unrolling, where wanted.
-pub fn facet_frames(panel: &Panel) -> Result<Vec<FacetFrame>, FlattenError> {
-    unroll(panel).map(|(_, frames)| frames)
+pub fn facet_frames<'a>(panel: impl Into<PanelRef<'a>>) -> Result<Vec<FacetFrame>, FlattenError> {
+    unroll(panel.into()).map(|(_, frames)| frames)
 }
 
 /// The flat panel and its facet frames.
-fn unroll(panel: &Panel) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
+fn unroll(panel: PanelRef) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
     let fail_id = || panel.id().to_string();
     let normals: Vec<DVec3> = panel
         .facets
@@ -209,41 +207,39 @@ fn unroll(panel: &Panel) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
 
 /// Unrolls a panel and fits its labels: the flatten stage for one panel. Returns how
 /// many labels were left out.
-pub fn unroll_and_fit(
-    panel: &Panel,
+pub fn unroll_and_fit<'a>(
+    panel: impl Into<PanelRef<'a>>,
     options: LabelOptions,
 ) -> Result<(FlatPanel, LeftOut), FlattenError> {
+    let panel = panel.into();
     let (mut flat, frames) = unroll(panel)?;
     let left_out = fit_labels(&mut flat, panel, &frames, options);
     Ok((flat, left_out))
 }
 
 /// Unrolls every panel and fits its labels (the pipeline's flatten stage), in
-/// parallel; the flat panels come in panel order, with how many labels were left out.
-/// On failure the error is that of the first panel, in panel order, that fails,
-/// whatever the thread count.
+/// parallel; the flat panels come in panel order, in one arena, with how many labels
+/// were left out. On failure the error is that of the first panel, in panel order,
+/// that fails, whatever the thread count.
 pub fn unroll_all(
-    panels: &[Panel],
+    panels: &Panels,
     options: LabelOptions,
-) -> Result<(Vec<FlatPanel>, LeftOut), FlattenError> {
-    let unrolled: Vec<Result<(FlatPanel, LeftOut), FlattenError>> = panels
-        .par_iter()
-        .map(|panel| unroll_and_fit(panel, options))
-        .collect();
-    if let Some(error) = unrolled.iter().find_map(|r| r.as_ref().err()) {
-        return Err(error.clone());
-    }
-    // Collected in place (the standard library reuses the buffer of `unrolled`): a
-    // second vector of a million flat panels would double their headers' memory.
+) -> Result<(FlatPanels, LeftOut), FlattenError> {
+    // A flat panel has the 3D panel's vertices as points, so that buffer's size is
+    // known; the others grow and are trimmed at the end.
+    let mut flat = FlatPanels::with_capacity(panels.len(), panels.vertex_count());
     let mut left_out = LeftOut::default();
-    let flat = unrolled
-        .into_iter()
-        .map(|result| {
-            let (panel, dropped) = result.expect("errors returned above");
+    make_in_order(
+        panels.len(),
+        |i| unroll_and_fit(panels.get(i), options),
+        |result| {
+            let (panel, dropped) = result?;
+            flat.push(panel.view());
             left_out = left_out + dropped;
-            panel
-        })
-        .collect();
+            Ok(())
+        },
+    )?;
+    flat.shrink_to_fit();
     Ok((flat, left_out))
 }
 
@@ -297,7 +293,7 @@ fn outline_loops(edges: &[EdgeUse], points: &[DVec2]) -> Option<Vec<Vec<u32>>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::panel::{Hole, Source};
+    use crate::panel::{Hole, Panel, Source};
     use crate::plane::signed_area;
 
     /// A unit square facet and a second square folded up by 90° along x = 1, plus a

@@ -6,7 +6,7 @@ use glam::{DVec2, DVec3};
 
 use crate::font::text_width;
 use crate::mesh::geometry::vector_area;
-use crate::panel::{FacetFrame, FlatLabel, FlatPanel, Label, LabelKind, Loops, Panel};
+use crate::panel::{FacetFrame, FlatLabel, FlatPanel, Label, LabelKind, LoopsRef, PanelRef};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
 
 /// Smallest cap height worth engraving (mm).
@@ -32,7 +32,7 @@ impl Default for LabelOptions {
 /// inside a facet has less area than it, and a facet's area in the plane is at most
 /// its 3D vector area, so these labels would be left out anyway: dropping them early
 /// changes no output. Returns how many of each kind were dropped.
-pub fn drop_unfittable(vertices: &[DVec3], facets: &Loops, labels: &mut Vec<Label>) -> LeftOut {
+pub fn drop_unfittable(vertices: &[DVec3], facets: LoopsRef, labels: &mut Vec<Label>) -> LeftOut {
     let mut dropped = LeftOut::default();
     if labels.is_empty() {
         return dropped;
@@ -123,12 +123,12 @@ impl std::ops::Add for LeftOut {
 /// get the room.
 pub fn fit_labels(
     panel: &mut FlatPanel,
-    source: &Panel,
+    source: PanelRef,
     frames: &[FacetFrame],
     options: LabelOptions,
 ) -> LeftOut {
-    let wanted_labels = &source.labels;
-    let facets = &source.facets;
+    let wanted_labels = source.labels;
+    let facets = source.facets;
     let mut order: Vec<usize> = (0..wanted_labels.len()).collect();
     order.sort_by_key(|&i| (wanted_labels[i].kind, i));
     let mut placed: Vec<[DVec2; 4]> = Vec::new();
@@ -189,7 +189,7 @@ struct Attempt {
 }
 
 /// The three largest other facets, each at its centroid along its longest edge.
-fn fallback_attempts(panel: &FlatPanel, facets: &Loops, skip: usize) -> Vec<Attempt> {
+fn fallback_attempts(panel: &FlatPanel, facets: LoopsRef, skip: usize) -> Vec<Attempt> {
     let mut by_area: Vec<(f64, usize)> = facets
         .iter()
         .enumerate()
@@ -231,7 +231,7 @@ fn fallback_attempts(panel: &FlatPanel, facets: &Loops, skip: usize) -> Vec<Atte
 /// fits in its attempt's facet: (centre, direction, height, box).
 fn fit_one(
     panel: &FlatPanel,
-    facets: &Loops,
+    facets: LoopsRef,
     attempt: &Attempt,
     text_width: f64,
     wanted: f64,
@@ -337,7 +337,7 @@ fn grow(bx: &[DVec2; 4], d: f64) -> [DVec2; 4] {
 mod tests {
     use super::*;
     use crate::flatten::unroll_and_fit;
-    use crate::panel::{Name, Source};
+    use crate::panel::{Name, Panel, Source};
 
     fn label(text: Name, kind: LabelKind, facet: u32, height: f64, anchor: DVec3) -> Label {
         Label {

@@ -152,6 +152,14 @@ impl Loops {
         self.ends.push(self.indices.len() as u32);
     }
 
+    /// The same loops, borrowed.
+    pub fn view(&self) -> LoopsRef<'_> {
+        LoopsRef {
+            indices: &self.indices,
+            ends: &self.ends,
+        }
+    }
+
     /// Number of loops.
     pub fn len(&self) -> usize {
         self.ends.len()
@@ -164,9 +172,7 @@ impl Loops {
 
     /// Loop `k`, if there is one.
     pub fn get(&self, k: usize) -> Option<&[u32]> {
-        let end = *self.ends.get(k)? as usize;
-        let start = if k == 0 { 0 } else { self.ends[k - 1] as usize };
-        Some(&self.indices[start..end])
+        self.view().get(k)
     }
 
     /// The first loop.
@@ -176,10 +182,7 @@ impl Loops {
 
     /// The loops in order.
     pub fn iter(&self) -> LoopsIter<'_> {
-        LoopsIter {
-            loops: self,
-            range: 0..self.len(),
-        }
+        self.view().iter()
     }
 
     /// Indices in all loops together.
@@ -197,22 +200,95 @@ impl Loops {
 impl std::ops::Index<usize> for Loops {
     type Output = [u32];
     fn index(&self, k: usize) -> &[u32] {
+        self.view().loop_at(k)
+    }
+}
+
+/// Loops kept in buffers owned elsewhere: a [`Loops`] borrowed, or one panel's loops
+/// in a [`FlatPanels`] arena. `ends` count from the start of `indices`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LoopsRef<'a> {
+    indices: &'a [u32],
+    ends: &'a [u32],
+}
+
+impl<'a> LoopsRef<'a> {
+    /// Number of loops.
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// No loops at all.
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// Loop `k`, if there is one.
+    pub fn get(&self, k: usize) -> Option<&'a [u32]> {
+        let end = *self.ends.get(k)? as usize;
+        let start = if k == 0 { 0 } else { self.ends[k - 1] as usize };
+        Some(&self.indices[start..end])
+    }
+
+    /// The first loop.
+    pub fn first(&self) -> Option<&'a [u32]> {
+        self.get(0)
+    }
+
+    /// The loops in order.
+    pub fn iter(&self) -> LoopsIter<'a> {
+        LoopsIter {
+            loops: *self,
+            range: 0..self.len(),
+        }
+    }
+
+    /// Indices in all loops together.
+    pub fn index_count(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// Loop `k`; panics when there is none, as indexing does.
+    fn loop_at(&self, k: usize) -> &'a [u32] {
         self.get(k)
             .unwrap_or_else(|| panic!("loop {k} of {}", self.len()))
     }
 }
 
-/// The loops of a [`Loops`], in order.
+impl std::ops::Index<usize> for LoopsRef<'_> {
+    type Output = [u32];
+    fn index(&self, k: usize) -> &[u32] {
+        self.loop_at(k)
+    }
+}
+
+impl<'a> IntoIterator for &LoopsRef<'a> {
+    type Item = &'a [u32];
+    type IntoIter = LoopsIter<'a>;
+    fn into_iter(self) -> LoopsIter<'a> {
+        self.iter()
+    }
+}
+
+impl<'a> IntoIterator for LoopsRef<'a> {
+    type Item = &'a [u32];
+    type IntoIter = LoopsIter<'a>;
+    fn into_iter(self) -> LoopsIter<'a> {
+        self.iter()
+    }
+}
+
+/// The loops of a [`Loops`] or [`LoopsRef`], in order.
 #[derive(Clone, Debug)]
 pub struct LoopsIter<'a> {
-    loops: &'a Loops,
+    loops: LoopsRef<'a>,
     range: std::ops::Range<usize>,
 }
 
 impl<'a> Iterator for LoopsIter<'a> {
     type Item = &'a [u32];
     fn next(&mut self) -> Option<&'a [u32]> {
-        self.range.next().map(|k| &self.loops[k])
+        self.range.next().map(|k| self.loops.loop_at(k))
     }
     fn size_hint(&self) -> (usize, Option<usize>) {
         self.range.size_hint()
@@ -221,7 +297,7 @@ impl<'a> Iterator for LoopsIter<'a> {
 
 impl DoubleEndedIterator for LoopsIter<'_> {
     fn next_back(&mut self) -> Option<Self::Item> {
-        self.range.next_back().map(|k| &self.loops[k])
+        self.range.next_back().map(|k| self.loops.loop_at(k))
     }
 }
 
@@ -276,7 +352,7 @@ impl Panel {
         mut holes: Vec<Hole>,
         mut labels: Vec<Label>,
     ) -> Self {
-        let labels_dropped = crate::labels::drop_unfittable(&vertices, &facets, &mut labels);
+        let labels_dropped = crate::labels::drop_unfittable(&vertices, facets.view(), &mut labels);
         vertices.shrink_to_fit();
         facets.shrink_to_fit();
         holes.shrink_to_fit();
@@ -294,6 +370,287 @@ impl Panel {
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
         self.source.name()
+    }
+
+    /// The same panel, borrowed as the arena hands panels out.
+    pub fn view(&self) -> PanelRef<'_> {
+        PanelRef {
+            source: self.source,
+            vertices: &self.vertices,
+            facets: self.facets.view(),
+            holes: &self.holes,
+            labels: &self.labels,
+            labels_dropped: self.labels_dropped,
+        }
+    }
+}
+
+/// A 3D panel borrowed from a [`Panels`] arena (or from a [`Panel`]): the same
+/// fields, as slices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanelRef<'a> {
+    /// Provenance (and so the printed id).
+    pub source: Source,
+    /// Corner positions shared by the facets.
+    pub vertices: &'a [DVec3],
+    /// Planar facets as vertex index loops, counter-clockwise seen from the outside.
+    pub facets: LoopsRef<'a>,
+    /// Fastener holes.
+    pub holes: &'a [Hole],
+    /// Labels that may fit.
+    pub labels: &'a [Label],
+    /// Labels dropped when the panel was made (see [`Panel::labels_dropped`]).
+    pub labels_dropped: LeftOut,
+}
+
+impl<'a> From<&'a Panel> for PanelRef<'a> {
+    fn from(panel: &'a Panel) -> Self {
+        panel.view()
+    }
+}
+
+impl PanelRef<'_> {
+    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    pub fn id(&self) -> Name {
+        self.source.name()
+    }
+
+    /// An owned copy.
+    pub fn to_owned(&self) -> Panel {
+        Panel {
+            source: self.source,
+            vertices: self.vertices.to_vec(),
+            facets: self.facets.iter().map(|f| f.iter().copied()).collect(),
+            holes: self.holes.to_vec(),
+            labels: self.labels.to_vec(),
+            labels_dropped: self.labels_dropped,
+        }
+    }
+}
+
+/// Where one panel's items start in each buffer of a [`Panels`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct PanelStarts {
+    vertices: u32,
+    facet_indices: u32,
+    facet_ends: u32,
+    holes: u32,
+    labels: u32,
+}
+
+/// What a [`Panels`] keeps of one panel beside its buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PanelHead {
+    source: Source,
+    starts: PanelStarts,
+    labels_dropped: LeftOut,
+}
+
+/// The 3D panels of a job, all in one arena, as [`FlatPanels`] keeps the flat ones:
+/// one buffer per kind of item and a small head per panel. Panels are handed out as
+/// [`PanelRef`]s.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Panels {
+    heads: Vec<PanelHead>,
+    vertices: Vec<DVec3>,
+    facet_indices: Vec<u32>,
+    facet_ends: Vec<u32>,
+    holes: Vec<Hole>,
+    labels: Vec<Label>,
+}
+
+/// Items made at a time by [`make_in_order`]: enough to keep the cores busy, few
+/// enough that the owned panels waiting to go into an arena stay a small part of it.
+const CHUNK: usize = 1 << 14;
+
+/// Makes `make(0)`, …, `make(count - 1)` in parallel, a chunk at a time, and hands
+/// them to `take` in that order (so the thread count changes nothing); `take` of one
+/// chunk runs while the next chunk is made. Stops at the first error `take` returns.
+/// This is how the arenas are filled: panels are made as owned values, in parallel,
+/// and copied into the arena in order, without ever holding them all.
+pub(crate) fn make_in_order<T: Send, E: Send>(
+    count: usize,
+    make: impl Fn(usize) -> T + Sync,
+    mut take: impl FnMut(T) -> Result<(), E> + Send,
+) -> Result<(), E> {
+    use rayon::prelude::*;
+    let make_chunk = |start: usize| -> Vec<T> {
+        (start.min(count)..(start + CHUNK).min(count))
+            .into_par_iter()
+            .map(&make)
+            .collect()
+    };
+    let mut made = make_chunk(0);
+    let mut start = 0;
+    while !made.is_empty() {
+        let current = std::mem::take(&mut made);
+        let (next, taken) = rayon::join(
+            || make_chunk(start + CHUNK),
+            || current.into_iter().try_for_each(&mut take),
+        );
+        taken?;
+        made = next;
+        start += CHUNK;
+    }
+    Ok(())
+}
+
+impl Panels {
+    /// No panels.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Panels `make(0)`, …, `make(count - 1)`, made in parallel a chunk at a time and
+    /// stored in that order (so the thread count changes nothing).
+    pub fn build(count: usize, make: impl Fn(usize) -> Panel + Sync) -> Self {
+        let mut all = Panels::new();
+        all.heads.reserve_exact(count);
+        let done: Result<(), std::convert::Infallible> = make_in_order(count, make, |panel| {
+            all.push(panel.view());
+            Ok(())
+        });
+        let Ok(()) = done;
+        all.shrink_to_fit();
+        all
+    }
+
+    /// Number of panels.
+    pub fn len(&self) -> usize {
+        self.heads.len()
+    }
+
+    /// No panels at all.
+    pub fn is_empty(&self) -> bool {
+        self.heads.is_empty()
+    }
+
+    /// Appends a copy of a panel.
+    ///
+    /// # Panics
+    /// When a buffer would pass 2³² items (about 100 GB of vertices alone).
+    pub fn push(&mut self, panel: PanelRef<'_>) {
+        let start = |len: usize| u32::try_from(len).expect("fewer than 2^32 panel items");
+        self.heads.push(PanelHead {
+            source: panel.source,
+            starts: PanelStarts {
+                vertices: start(self.vertices.len()),
+                facet_indices: start(self.facet_indices.len()),
+                facet_ends: start(self.facet_ends.len()),
+                holes: start(self.holes.len()),
+                labels: start(self.labels.len()),
+            },
+            labels_dropped: panel.labels_dropped,
+        });
+        self.vertices.extend_from_slice(panel.vertices);
+        self.facet_indices.extend_from_slice(panel.facets.indices);
+        self.facet_ends.extend_from_slice(panel.facets.ends);
+        self.holes.extend_from_slice(panel.holes);
+        self.labels.extend_from_slice(panel.labels);
+        start(
+            self.vertices
+                .len()
+                .max(self.facet_indices.len())
+                .max(self.labels.len()),
+        );
+    }
+
+    /// Gives back spare capacity (the arena is filled once and kept).
+    pub fn shrink_to_fit(&mut self) {
+        self.heads.shrink_to_fit();
+        self.vertices.shrink_to_fit();
+        self.facet_indices.shrink_to_fit();
+        self.facet_ends.shrink_to_fit();
+        self.holes.shrink_to_fit();
+        self.labels.shrink_to_fit();
+    }
+
+    /// Vertices of all panels together.
+    pub fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
+    /// Panel `i`.
+    ///
+    /// # Panics
+    /// When there is no panel `i`, as indexing does.
+    pub fn get(&self, i: usize) -> PanelRef<'_> {
+        let head = &self.heads[i];
+        let start = head.starts;
+        let end = self.heads.get(i + 1).map_or(
+            PanelStarts {
+                vertices: self.vertices.len() as u32,
+                facet_indices: self.facet_indices.len() as u32,
+                facet_ends: self.facet_ends.len() as u32,
+                holes: self.holes.len() as u32,
+                labels: self.labels.len() as u32,
+            },
+            |next| next.starts,
+        );
+        let range = |a: u32, b: u32| a as usize..b as usize;
+        PanelRef {
+            source: head.source,
+            vertices: &self.vertices[range(start.vertices, end.vertices)],
+            facets: LoopsRef {
+                indices: &self.facet_indices[range(start.facet_indices, end.facet_indices)],
+                ends: &self.facet_ends[range(start.facet_ends, end.facet_ends)],
+            },
+            holes: &self.holes[range(start.holes, end.holes)],
+            labels: &self.labels[range(start.labels, end.labels)],
+            labels_dropped: head.labels_dropped,
+        }
+    }
+
+    /// The panels in order.
+    pub fn iter(&self) -> PanelsIter<'_> {
+        PanelsIter {
+            panels: self,
+            range: 0..self.len(),
+        }
+    }
+}
+
+impl FromIterator<Panel> for Panels {
+    fn from_iter<I: IntoIterator<Item = Panel>>(panels: I) -> Self {
+        let mut all = Panels::new();
+        for panel in panels {
+            all.push(panel.view());
+        }
+        all.shrink_to_fit();
+        all
+    }
+}
+
+/// The panels of a [`Panels`], in order.
+#[derive(Clone, Debug)]
+pub struct PanelsIter<'a> {
+    panels: &'a Panels,
+    range: std::ops::Range<usize>,
+}
+
+impl<'a> Iterator for PanelsIter<'a> {
+    type Item = PanelRef<'a>;
+    fn next(&mut self) -> Option<PanelRef<'a>> {
+        self.range.next().map(|i| self.panels.get(i))
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.range.size_hint()
+    }
+}
+
+impl DoubleEndedIterator for PanelsIter<'_> {
+    fn next_back(&mut self) -> Option<Self::Item> {
+        self.range.next_back().map(|i| self.panels.get(i))
+    }
+}
+
+impl ExactSizeIterator for PanelsIter<'_> {}
+
+impl<'a> IntoIterator for &'a Panels {
+    type Item = PanelRef<'a>;
+    type IntoIter = PanelsIter<'a>;
+    fn into_iter(self) -> PanelsIter<'a> {
+        self.iter()
     }
 }
 
@@ -407,6 +764,60 @@ pub struct FlatPanel {
 }
 
 impl FlatPanel {
+    /// The same panel, borrowed as the arena hands panels out.
+    pub fn view(&self) -> FlatPanelRef<'_> {
+        FlatPanelRef {
+            source: self.source,
+            points: &self.points,
+            outline: self.outline.view(),
+            scores: &self.scores,
+            holes: &self.holes,
+            labels: &self.labels,
+            developability_error: self.developability_error,
+            area: self.area,
+        }
+    }
+
+    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    pub fn id(&self) -> Name {
+        self.source.name()
+    }
+
+    /// The points of an outline loop.
+    pub fn loop_points(&self, lp: &[u32]) -> Vec<DVec2> {
+        self.view().loop_points(lp)
+    }
+
+    /// The outer outline's points.
+    pub fn outer(&self) -> Vec<DVec2> {
+        self.view().outer()
+    }
+}
+
+/// A flat panel borrowed from a [`FlatPanels`] arena (or from a [`FlatPanel`]): the
+/// same fields, as slices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlatPanelRef<'a> {
+    /// Provenance (and so the printed id).
+    pub source: Source,
+    /// Corner positions in the plane (same indices as the 3D panel's vertices).
+    pub points: &'a [DVec2],
+    /// Cut loops: the outer outline first (counter-clockwise), then inner cuts
+    /// (clockwise).
+    pub outline: LoopsRef<'a>,
+    /// Fold lines to score.
+    pub scores: &'a [[u32; 2]],
+    /// Fastener holes.
+    pub holes: &'a [FlatHole],
+    /// Labels after fitting.
+    pub labels: &'a [FlatLabel],
+    /// Largest change of a facet edge length between 3D and the plane (mm).
+    pub developability_error: f64,
+    /// Area of the facets in the plane (mm²), holes not subtracted.
+    pub area: f64,
+}
+
+impl FlatPanelRef<'_> {
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
         self.source.name()
@@ -433,6 +844,213 @@ impl FlatPanel {
         }
         best.sqrt()
     }
+
+    /// An owned copy.
+    pub fn to_owned(&self) -> FlatPanel {
+        FlatPanel {
+            source: self.source,
+            points: self.points.to_vec(),
+            outline: self.outline.iter().map(|lp| lp.iter().copied()).collect(),
+            scores: self.scores.to_vec(),
+            holes: self.holes.to_vec(),
+            labels: self.labels.to_vec(),
+            developability_error: self.developability_error,
+            area: self.area,
+        }
+    }
+}
+
+/// Where one panel's items start in each buffer of a [`FlatPanels`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct FlatStarts {
+    points: u32,
+    loop_indices: u32,
+    loop_ends: u32,
+    scores: u32,
+    holes: u32,
+    labels: u32,
+}
+
+/// What a [`FlatPanels`] keeps of one panel beside its buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct FlatHead {
+    source: Source,
+    starts: FlatStarts,
+    developability_error: f64,
+    area: f64,
+}
+
+/// The flat panels of a job, all in one arena: one buffer per kind of item (points,
+/// outline indices, scores, holes, labels) and a small head per panel saying where
+/// its items start. A big job has millions of flat panels of a dozen points each; as
+/// separate [`FlatPanel`]s they cost four allocations and a 200-byte struct apiece,
+/// more than their points. Panels are handed out as [`FlatPanelRef`]s.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FlatPanels {
+    heads: Vec<FlatHead>,
+    points: Vec<DVec2>,
+    loop_indices: Vec<u32>,
+    loop_ends: Vec<u32>,
+    scores: Vec<[u32; 2]>,
+    holes: Vec<FlatHole>,
+    labels: Vec<FlatLabel>,
+}
+
+impl FlatPanels {
+    /// No panels.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// No panels, with room for `panels` panels of `points` points in all.
+    pub fn with_capacity(panels: usize, points: usize) -> Self {
+        FlatPanels {
+            heads: Vec::with_capacity(panels),
+            points: Vec::with_capacity(points),
+            ..Self::default()
+        }
+    }
+
+    /// Number of panels.
+    pub fn len(&self) -> usize {
+        self.heads.len()
+    }
+
+    /// No panels at all.
+    pub fn is_empty(&self) -> bool {
+        self.heads.is_empty()
+    }
+
+    /// Appends a copy of a panel.
+    ///
+    /// # Panics
+    /// When a buffer would pass 2³² items (about 70 GB of points alone).
+    pub fn push(&mut self, panel: FlatPanelRef<'_>) {
+        let start = |len: usize| u32::try_from(len).expect("fewer than 2^32 flat items");
+        self.heads.push(FlatHead {
+            source: panel.source,
+            starts: FlatStarts {
+                points: start(self.points.len()),
+                loop_indices: start(self.loop_indices.len()),
+                loop_ends: start(self.loop_ends.len()),
+                scores: start(self.scores.len()),
+                holes: start(self.holes.len()),
+                labels: start(self.labels.len()),
+            },
+            developability_error: panel.developability_error,
+            area: panel.area,
+        });
+        self.points.extend_from_slice(panel.points);
+        self.loop_indices.extend_from_slice(panel.outline.indices);
+        self.loop_ends.extend_from_slice(panel.outline.ends);
+        self.scores.extend_from_slice(panel.scores);
+        self.holes.extend_from_slice(panel.holes);
+        self.labels.extend_from_slice(panel.labels);
+        // Checked once per panel: the buffers only grow, so the last start bounds all.
+        start(
+            self.points
+                .len()
+                .max(self.loop_indices.len())
+                .max(self.labels.len()),
+        );
+    }
+
+    /// Gives back spare capacity (the arena is filled once and kept).
+    pub fn shrink_to_fit(&mut self) {
+        self.heads.shrink_to_fit();
+        self.points.shrink_to_fit();
+        self.loop_indices.shrink_to_fit();
+        self.loop_ends.shrink_to_fit();
+        self.scores.shrink_to_fit();
+        self.holes.shrink_to_fit();
+        self.labels.shrink_to_fit();
+    }
+
+    /// Panel `i`.
+    ///
+    /// # Panics
+    /// When there is no panel `i`, as indexing does.
+    pub fn get(&self, i: usize) -> FlatPanelRef<'_> {
+        let head = &self.heads[i];
+        let start = head.starts;
+        let end = self.heads.get(i + 1).map_or(
+            FlatStarts {
+                points: self.points.len() as u32,
+                loop_indices: self.loop_indices.len() as u32,
+                loop_ends: self.loop_ends.len() as u32,
+                scores: self.scores.len() as u32,
+                holes: self.holes.len() as u32,
+                labels: self.labels.len() as u32,
+            },
+            |next| next.starts,
+        );
+        let range = |a: u32, b: u32| a as usize..b as usize;
+        FlatPanelRef {
+            source: head.source,
+            points: &self.points[range(start.points, end.points)],
+            outline: LoopsRef {
+                indices: &self.loop_indices[range(start.loop_indices, end.loop_indices)],
+                ends: &self.loop_ends[range(start.loop_ends, end.loop_ends)],
+            },
+            scores: &self.scores[range(start.scores, end.scores)],
+            holes: &self.holes[range(start.holes, end.holes)],
+            labels: &self.labels[range(start.labels, end.labels)],
+            developability_error: head.developability_error,
+            area: head.area,
+        }
+    }
+
+    /// The panels in order.
+    pub fn iter(&self) -> FlatPanelsIter<'_> {
+        FlatPanelsIter {
+            panels: self,
+            range: 0..self.len(),
+        }
+    }
+}
+
+/// The panels of a [`FlatPanels`], in order.
+#[derive(Clone, Debug)]
+pub struct FlatPanelsIter<'a> {
+    panels: &'a FlatPanels,
+    range: std::ops::Range<usize>,
+}
+
+impl<'a> Iterator for FlatPanelsIter<'a> {
+    type Item = FlatPanelRef<'a>;
+    fn next(&mut self) -> Option<FlatPanelRef<'a>> {
+        self.range.next().map(|i| self.panels.get(i))
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.range.size_hint()
+    }
+}
+
+impl DoubleEndedIterator for FlatPanelsIter<'_> {
+    fn next_back(&mut self) -> Option<Self::Item> {
+        self.range.next_back().map(|i| self.panels.get(i))
+    }
+}
+
+impl ExactSizeIterator for FlatPanelsIter<'_> {}
+
+impl<'a> IntoIterator for &'a FlatPanels {
+    type Item = FlatPanelRef<'a>;
+    type IntoIter = FlatPanelsIter<'a>;
+    fn into_iter(self) -> FlatPanelsIter<'a> {
+        self.iter()
+    }
+}
+
+impl FromIterator<FlatPanel> for FlatPanels {
+    fn from_iter<I: IntoIterator<Item = FlatPanel>>(panels: I) -> Self {
+        let mut all = FlatPanels::new();
+        for panel in panels {
+            all.push(panel.view());
+        }
+        all.shrink_to_fit();
+        all
+    }
 }
 
 #[cfg(test)]
@@ -458,6 +1076,129 @@ mod tests {
         let rebuilt: Loops = collected.into_iter().collect();
         assert_eq!(rebuilt, loops);
         assert_eq!((&loops).into_iter().count(), 3);
+    }
+
+    /// A panel of `k + 1` triangles fanned around vertex 0, with `k % 3` holes and
+    /// `k % 2` labels: panels of different sizes, some with nothing of a kind.
+    fn fan(k: u32) -> Panel {
+        let vertices: Vec<DVec3> = (0..k + 3)
+            .map(|i| DVec3::new(i as f64, (i * i) as f64, k as f64))
+            .collect();
+        let facets: Loops = (0..=k).map(|i| [0, i + 1, i + 2]).collect();
+        let holes = (0..k % 3)
+            .map(|i| Hole {
+                position: DVec3::splat(i as f64),
+                diameter: 3.0,
+                connection: k + i,
+                facet: i,
+            })
+            .collect();
+        let labels = (0..k % 2)
+            .map(|_| Label {
+                text: Name::Edge(k),
+                anchor: DVec3::ZERO,
+                direction: DVec3::X,
+                height: 0.0,
+                facet: 0,
+                kind: LabelKind::Panel,
+                on_edge: false,
+                slide: 0.0,
+            })
+            .collect();
+        Panel {
+            source: Source::Edge(k),
+            vertices,
+            facets,
+            holes,
+            labels,
+            labels_dropped: LeftOut {
+                panel: k as usize,
+                partner: 0,
+                mark: 1,
+            },
+        }
+    }
+
+    /// The flat counterpart of [`fan`]: points, an outline with an inner loop on odd
+    /// panels, scores on every other.
+    fn flat_fan(k: u32) -> FlatPanel {
+        let panel = fan(k);
+        let mut outline = Loops::new();
+        outline.push(0..k + 3);
+        if k % 2 == 1 {
+            outline.push([2, 1, 0]);
+        }
+        FlatPanel {
+            source: panel.source,
+            points: panel.vertices.iter().map(|v| v.truncate()).collect(),
+            outline,
+            scores: (0..k % 2).map(|i| [0, i + 2]).collect(),
+            holes: (0..k % 3)
+                .map(|i| FlatHole {
+                    center: DVec2::splat(i as f64),
+                    diameter: 3.0,
+                    connection: k + i,
+                    facet: i,
+                })
+                .collect(),
+            labels: Vec::new(),
+            developability_error: 1e-12 * k as f64,
+            area: k as f64,
+        }
+    }
+
+    #[test]
+    fn arenas_hand_back_every_panel_as_it_went_in() {
+        let owned: Vec<Panel> = (0..7).map(fan).collect();
+        let arena: Panels = owned.iter().cloned().collect();
+        assert_eq!(arena.len(), 7);
+        assert_eq!(arena.vertex_count(), (3..10).sum::<usize>());
+        for (k, (got, want)) in arena.iter().zip(&owned).enumerate() {
+            assert_eq!(got, want.view(), "panel {k}");
+            assert_eq!(&got.to_owned(), want, "panel {k}");
+            assert_eq!(got.facets.len(), k + 1);
+        }
+        assert_eq!(
+            arena.iter().next_back().map(|p| p.id()),
+            Some(Name::Edge(6))
+        );
+
+        let flat_owned: Vec<FlatPanel> = (0..7).map(flat_fan).collect();
+        let flat: FlatPanels = flat_owned.iter().cloned().collect();
+        assert_eq!(flat.len(), 7);
+        for (k, (got, want)) in flat.iter().zip(&flat_owned).enumerate() {
+            assert_eq!(got, want.view(), "flat panel {k}");
+            assert_eq!(&got.to_owned(), want, "flat panel {k}");
+            assert_eq!(got.outer(), want.outer());
+            assert_eq!(got.outline.len(), 1 + k % 2);
+        }
+        assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
+    }
+
+    #[test]
+    fn built_arenas_keep_the_order_across_chunks() {
+        // More than two chunks, so the order is kept where chunks meet.
+        let count = 2 * CHUNK + 5;
+        let arena = Panels::build(count, |i| fan(i as u32 % 5));
+        assert_eq!(arena.len(), count);
+        for i in [0, CHUNK - 1, CHUNK, 2 * CHUNK + 4] {
+            assert_eq!(arena.get(i), fan(i as u32 % 5).view(), "panel {i}");
+        }
+        // The first error in order wins, and nothing after it is taken.
+        let mut taken = Vec::new();
+        let failed = make_in_order(
+            count,
+            |i| i,
+            |i| {
+                if i % 1000 == 999 && i > CHUNK {
+                    return Err(i);
+                }
+                taken.push(i);
+                Ok(())
+            },
+        );
+        assert_eq!(failed, Err(16_999));
+        assert_eq!(taken, (0..16_999).collect::<Vec<_>>());
     }
 
     #[test]

@@ -19,7 +19,7 @@ use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 
 use crate::nest::{lay_out, Layout, SheetSpec};
-use crate::panel::{FlatPanel, Source};
+use crate::panel::{FlatPanelRef, FlatPanels, Source};
 use crate::plane::is_simple;
 use crate::scheme::build_panels;
 
@@ -240,7 +240,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
     let too_large = |e: crate::nest::TooLarge| {
         Error::Runtime(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
-            flat[e.part].id(), e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
+            flat.get(e.part).id(), e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))
     };
     let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
@@ -293,11 +293,11 @@ pub fn run(job: &Job) -> Result<Outcome> {
             }
             let mut lengths = Lengths::default();
             draw_sheet(&layout, index, &flat, &mut lengths);
-            let on_sheet: Vec<&FlatPanel> = layout
+            let on_sheet: Vec<FlatPanelRef> = layout
                 .placements
                 .iter()
                 .filter(|p| p.sheet == index)
-                .map(|p| &flat[p.part])
+                .map(|p| flat.get(p.part))
                 .collect();
             let area: f64 = on_sheet.iter().map(|p| p.area).sum();
             let entry = manifest::SheetEntry {
@@ -365,7 +365,7 @@ fn build_manifest(
     split: &crate::mesh::split::SplitReport,
     mm_per_unit: f64,
     output: &crate::scheme::SchemeOutput,
-    flat: &[FlatPanel],
+    flat: &FlatPanels,
     layout: &Layout,
     lengths: Lengths,
     labels_left_out: LeftOut,

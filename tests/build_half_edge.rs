@@ -831,7 +831,8 @@ fn labels_are_inside_their_panels() {
     assert_eq!(connections, 100);
     let mut left_out = 0;
     for ((fp, panel), frames) in flat.iter_mut().zip(&panels).zip(frames_of(&panels)) {
-        left_out += unfold::labels::fit_labels(fp, panel, &frames, Default::default()).total();
+        left_out +=
+            unfold::labels::fit_labels(fp, panel.view(), &frames, Default::default()).total();
     }
     assert_eq!(left_out, 0);
     let mut partner_labels = 0;

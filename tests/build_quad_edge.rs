@@ -230,7 +230,7 @@ fn check_panels(p: &Pipeline, job: &Job, what: &str) {
         face_corners(mesh),
         "{what}: connections = face corners"
     );
-    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+    for (panel, fp) in p.panels.iter().zip(&p.flat) {
         let e = edge_of(fp);
         assert_eq!(fp.id().to_string(), format!("E{}", e.0), "{what}: panel id");
         let facets = if mesh.is_boundary_edge(e) { 1 } else { n + 2 };
@@ -277,7 +277,7 @@ fn check_panels(p: &Pipeline, job: &Job, what: &str) {
 /// worst relative error.
 fn check_developable(p: &Pipeline, what: &str, rel: f64) -> f64 {
     let mut worst = 0.0f64;
-    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+    for (panel, fp) in p.panels.iter().zip(&p.flat) {
         let size = diameter(&fp.outer(), DVec2::distance);
         let mut error = 0.0f64;
         for facet in &panel.facets {
@@ -323,7 +323,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
         10.0 * job.model.planarity_tol
     };
     let mut strips = 0;
-    for (panel, fp) in p.output.panels.iter().zip(&p.flat) {
+    for (panel, fp) in p.panels.iter().zip(&p.flat) {
         let e = edge_of(fp);
         let h = e.half_edge();
         let at = |i: u32| panel.vertices[i as usize];
@@ -547,7 +547,7 @@ fn check_holes(
     let tol = rel_tol * size_mm;
     let n = o.samples as usize;
     let exact = 1e-9 * size_mm;
-    let frames = frames_of(&p.output.panels);
+    let frames = frames_of(&p.panels);
 
     // connection → [(panel index, unrolled point mapped back to 3D, the 3D hole)]
     let mut by_connection: BTreeMap<u32, Vec<(usize, DVec3, DVec3)>> = BTreeMap::new();
@@ -555,11 +555,11 @@ fn check_holes(
     for (k, fp) in p.flat.iter().enumerate() {
         assert_eq!(
             fp.holes.len(),
-            p.output.panels[k].holes.len(),
+            p.panels[k].holes.len(),
             "{what}: {}",
             fp.id()
         );
-        let panel = &p.output.panels[k];
+        let panel = &p.panels[k];
         let last = panel.facets.len() - 1;
         for (hole, hole3) in fp.holes.iter().zip(&panel.holes) {
             holes += 1;
@@ -1044,7 +1044,7 @@ fn open_meshes_give_boundary_edges_a_single_flap() {
         let single: Vec<&FlatPanel> = p
             .flat
             .iter()
-            .zip(&p.output.panels)
+            .zip(&p.panels)
             .filter(|(_, panel)| panel.facets.len() == 1)
             .map(|(fp, _)| fp)
             .collect();

@@ -67,7 +67,7 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
     let p = pipeline(job);
     let size = 300.0;
     let mut by_connection: BTreeMap<u32, BTreeMap<String, Vec<DVec3>>> = BTreeMap::new();
-    for (flat, frames) in p.flat.iter().zip(frames_of(&p.output.panels)) {
+    for (flat, frames) in p.flat.iter().zip(frames_of(&p.panels)) {
         for hole in &flat.holes {
             let back = frames[hole.facet as usize].to_3d(hole.center);
             by_connection

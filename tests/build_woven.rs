@@ -140,7 +140,7 @@ fn the_holes_of_a_lap_joint_meet_in_3d() {
         let job = woven_job(name, "200mm", tmp.path());
         let p = pipeline(&job);
         let mut by_joint: BTreeMap<u32, Vec<(String, u32, DVec3)>> = BTreeMap::new();
-        for (flat, frames) in p.flat.iter().zip(frames_of(&p.output.panels)) {
+        for (flat, frames) in p.flat.iter().zip(frames_of(&p.panels)) {
             for hole in &flat.holes {
                 let back = frames[hole.facet as usize].to_3d(hole.center);
                 by_joint.entry(hole.connection).or_default().push((
@@ -199,7 +199,7 @@ fn ribbons_do_not_pass_through_each_other() {
         let job = woven_job(name, "200mm", tmp.path());
         let p = pipeline(&job);
         let mut triangles: Vec<[DVec3; 3]> = Vec::new();
-        for panel in &p.output.panels {
+        for panel in &p.panels {
             for facet in &panel.facets {
                 let v = |i: u32| panel.vertices[i as usize];
                 for k in 1..facet.len() - 1 {
@@ -301,7 +301,7 @@ fn flat_ribbons_without_thickness_have_no_turns() {
     o.thickness = Some("0mm".into());
     let job = resolve(o, &model("hexahedron"));
     let p = pipeline(&job);
-    for panel in &p.output.panels {
+    for panel in &p.panels {
         assert!(
             panel.facets.iter().all(|f| f.len() == 4),
             "{}: with no thickness every piece is one planar quad",

@@ -12,7 +12,7 @@ use glam::DVec2;
 
 use crate::font::text_strokes;
 use crate::nest::{Layout, Placement};
-use crate::panel::FlatPanel;
+use crate::panel::{FlatPanelRef, FlatPanels};
 
 /// The three kinds of laser geometry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -80,25 +80,25 @@ impl Lengths {
 }
 
 /// Draws sheet `index` of `layout` into `sink`.
-pub fn draw_sheet(layout: &Layout, index: usize, panels: &[FlatPanel], sink: &mut dyn SheetSink) {
+pub fn draw_sheet(layout: &Layout, index: usize, panels: &FlatPanels, sink: &mut dyn SheetSink) {
     let on_sheet: Vec<&Placement> = layout
         .placements
         .iter()
         .filter(|p| p.sheet == index)
         .collect();
     for p in &on_sheet {
-        draw_labels(&panels[p.part], p, sink);
+        draw_labels(panels.get(p.part), p, sink);
     }
     for p in &on_sheet {
-        let panel = &panels[p.part];
-        for &[a, b] in &panel.scores {
+        let panel = panels.get(p.part);
+        for &[a, b] in panel.scores {
             let line = [panel.points[a as usize], panel.points[b as usize]].map(|q| p.apply(q));
             sink.polyline(Kind::Score, &line, false);
         }
     }
     for p in &on_sheet {
-        let panel = &panels[p.part];
-        for hole in &panel.holes {
+        let panel = panels.get(p.part);
+        for hole in panel.holes {
             sink.circle(Kind::Cut, p.apply(hole.center), 0.5 * hole.diameter);
         }
         for lp in panel.outline.iter().skip(1) {
@@ -118,8 +118,8 @@ pub fn draw_sheet(layout: &Layout, index: usize, panels: &[FlatPanel], sink: &mu
 
 /// A label's strokes: scaled to its cap height, its box centred on the label centre,
 /// reading along its direction.
-fn draw_labels(panel: &FlatPanel, placement: &Placement, sink: &mut dyn SheetSink) {
-    for label in &panel.labels {
+fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetSink) {
+    for label in panel.labels {
         let strokes = text_strokes(label.text);
         let h = label.height;
         // Read left to right on the sheet: turning the text half a turn about its box

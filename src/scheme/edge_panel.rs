@@ -10,7 +10,7 @@ use rayon::prelude::*;
 
 use super::{face_band, SchemeOptions};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
-use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Source};
+use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
 
 /// The id printed for an edge panel.
@@ -266,17 +266,16 @@ pub fn edge_scheme_notes(
 }
 
 /// Builds every edge panel from the faces' flaps. Returns the panels (in edge order).
-pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &SchemeOptions) -> Vec<Panel> {
+pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &SchemeOptions) -> Panels {
     let mut corner_of = vec![0u32; mesh.half_edge_count()];
     for f in mesh.faces() {
         for (k, h) in mesh.face_half_edges(f).enumerate() {
             corner_of[h.index()] = k as u32;
         }
     }
-    (0..mesh.edge_count() as u32)
-        .into_par_iter()
-        .map(|e| edge_panel(mesh, EdgeId(e), faces, &corner_of, options))
-        .collect()
+    Panels::build(mesh.edge_count(), |e| {
+        edge_panel(mesh, EdgeId(e as u32), faces, &corner_of, options)
+    })
 }
 
 /// Quadratic Bézier point.

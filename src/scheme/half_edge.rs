@@ -9,11 +9,10 @@
 //! the faces and the tab first spans the gap in its own face's plane (a bridge facet).
 
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 
 use super::{face_band, SchemeOptions, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
-use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Source};
+use crate::panel::{make_in_order, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
@@ -34,6 +33,41 @@ struct Tab {
     holes_skipped: bool,
 }
 
+/// The tabs of a mesh's edges, kept sparse: on a fine mesh most edges have none (the
+/// neighbour face is too small to hold one), and a slot the size of a tab per edge
+/// would cost more than the panels.
+struct Tabs {
+    /// Per edge, the index of its tab in `tabs`, or `NO_TAB`.
+    slot: Vec<u32>,
+    /// The tabs, in edge order.
+    tabs: Vec<Tab>,
+}
+
+/// The slot of an edge without a tab.
+const NO_TAB: u32 = u32::MAX;
+
+impl Tabs {
+    /// Appends the next edge's tab (or its lack of one).
+    fn push(&mut self, tab: Option<Tab>) {
+        match tab {
+            Some(tab) => {
+                // Fewer tabs than edges, and edge ids are u32.
+                self.slot.push(self.tabs.len() as u32);
+                self.tabs.push(tab);
+            }
+            None => self.slot.push(NO_TAB),
+        }
+    }
+
+    /// The tab of edge `e`, if it has one.
+    fn of_edge(&self, e: EdgeId) -> Option<&Tab> {
+        match self.slot[e.index()] {
+            NO_TAB => None,
+            k => Some(&self.tabs[k as usize]),
+        }
+    }
+}
+
 /// The id printed for a face panel.
 pub fn panel_id(f: FaceId) -> Name {
     Name::Face(f.0)
@@ -42,15 +76,16 @@ pub fn panel_id(f: FaceId) -> Name {
 /// Builds the face panels of a mesh whose faces are planar and star-shaped from their
 /// centres (the split stage ensures both).
 pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
-    let s = options.face_scale;
-    let bands: Vec<Vec<DVec3>> = mesh.faces().map(|f| face_band(mesh, f, s)).collect();
-
     // Tabs per edge (interior edges only), computed independently in parallel and
     // collected in edge order.
-    let tabs: Vec<Option<Tab>> = (0..mesh.edge_count() as u32)
-        .into_par_iter()
-        .map(|e| {
-            let e = EdgeId(e);
+    let mut tabs = Tabs {
+        slot: Vec::with_capacity(mesh.edge_count()),
+        tabs: Vec::new(),
+    };
+    let made: Result<(), std::convert::Infallible> = make_in_order(
+        mesh.edge_count(),
+        |e| {
+            let e = EdgeId(e as u32);
             if !options.tabs || mesh.is_boundary_edge(e) {
                 return None;
             }
@@ -61,11 +96,17 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
             } else {
                 e.half_edge().twin()
             };
-            make_tab(mesh, owner, &bands, options)
-        })
-        .collect();
+            make_tab(mesh, owner, options)
+        },
+        |tab| {
+            tabs.push(tab);
+            Ok(())
+        },
+    );
+    let Ok(()) = made;
+    tabs.tabs.shrink_to_fit();
 
-    let connections = tabs.iter().flatten().count();
+    let connections = tabs.tabs.len();
     let mut notes = Vec::new();
     let interior = mesh.edges().filter(|&e| !mesh.is_boundary_edge(e)).count();
     if options.tabs && connections < interior {
@@ -74,13 +115,13 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
             interior - connections
         ));
     }
-    let shortened = tabs.iter().flatten().filter(|t| t.shortened).count();
+    let shortened = tabs.tabs.iter().filter(|t| t.shortened).count();
     if shortened > 0 {
         notes.push(format!(
             "{shortened} tabs were shortened to stay inside their neighbour face"
         ));
     }
-    let skipped = tabs.iter().flatten().filter(|t| t.holes_skipped).count();
+    let skipped = tabs.tabs.iter().filter(|t| t.holes_skipped).count();
     if skipped > 0 {
         notes.push(format!(
             "{skipped} connections have no fastener holes: the tab is too small for a {} mm hole",
@@ -88,10 +129,16 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
         ));
     }
 
-    let panels = (0..mesh.face_count() as u32)
-        .into_par_iter()
-        .map(|f| face_panel(mesh, FaceId(f), &bands[f as usize], &tabs, options))
-        .collect();
+    let panels = Panels::build(mesh.face_count(), |f| {
+        let f = FaceId(f as u32);
+        face_panel(
+            mesh,
+            f,
+            &face_band(mesh, f, options.face_scale),
+            &tabs,
+            options,
+        )
+    });
     SchemeOutput {
         panels,
         connections,
@@ -105,7 +152,7 @@ fn face_panel(
     mesh: &Mesh,
     f: FaceId,
     band: &[DVec3],
-    tabs: &[Option<Tab>],
+    tabs: &Tabs,
     options: &SchemeOptions,
 ) -> Panel {
     let s = options.face_scale;
@@ -121,7 +168,7 @@ fn face_panel(
     let mut holes = Vec::new();
     let mut labels = Vec::new();
     // Facet 0 is the band; tab facets follow (indices known once pushed).
-    let tab_of = |h: HalfEdgeId| tabs[h.edge().index()].as_ref();
+    let tab_of = |h: HalfEdgeId| tabs.of_edge(h.edge());
     let mut pending_tabs: Vec<(&Tab, u32, u32)> = Vec::new();
     // With s < 1, the mesh corners where bridges meet: one vertex per corner, shared by
     // the bridges on both sides so that their common side is a (flat) hinge, not a
@@ -232,12 +279,7 @@ fn face_panel(
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
 /// `None` when the neighbour cannot hold one.
-fn make_tab(
-    mesh: &Mesh,
-    owner: HalfEdgeId,
-    bands: &[Vec<DVec3>],
-    options: &SchemeOptions,
-) -> Option<Tab> {
+fn make_tab(mesh: &Mesh, owner: HalfEdgeId, options: &SchemeOptions) -> Option<Tab> {
     let g = mesh.face(owner.twin())?;
     let (a, b) = (
         mesh.position(mesh.origin(owner)),
@@ -297,7 +339,7 @@ fn make_tab(
     let top: Vec<DVec3> = ccw[2..].iter().rev().map(|&q| to3(q)).collect();
 
     let (holes, holes_skipped) =
-        place_holes(&ccw, gap, top_height, &bands[g.index()], &to2, options);
+        place_holes(&ccw, gap, top_height, &face_band(mesh, g, s), &to2, options);
     Some(Tab {
         owner,
         base: [to3(DVec2::new(lo, 0.0)), to3(DVec2::new(hi, 0.0))],

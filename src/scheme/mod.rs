@@ -13,7 +13,7 @@ use glam::DVec3;
 
 use crate::config::SchemeName;
 use crate::mesh::{FaceId, Mesh};
-use crate::panel::Panel;
+use crate::panel::Panels;
 
 /// Options shared by the schemes (lengths in mm, fractions as fractions).
 #[derive(Clone, Debug, PartialEq)]
@@ -67,7 +67,7 @@ pub struct PanelLimit {
 #[derive(Clone, Debug, Default)]
 pub struct SchemeOutput {
     /// The panels, in a deterministic order.
-    pub panels: Vec<Panel>,
+    pub panels: Panels,
     /// Number of connections (links between two panels).
     pub connections: usize,
     /// Observations for the report (tabs shortened or left out, holes skipped).

@@ -31,7 +31,7 @@ use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
 use crate::nest::shelf::{fits_rotated, smallest_box};
-use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Source};
+use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{
     clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, segment_distance,
 };
@@ -750,7 +750,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
         .into_iter()
         .collect::<Result<_, _>>()?;
 
-    let mut panels = Vec::new();
+    let mut panels = Panels::new();
     let mut cycles = Vec::new();
     let mut joint = 0u32;
     let mut holes_short = 0;
@@ -762,7 +762,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
             let partners = [(s + m - 1) % m, (s + 1) % m];
             let (panel, short) = segment_panel(ribbon, s, start, len, joints, partners, options);
             holes_short += short;
-            panels.push(panel);
+            panels.push(panel.view());
         }
         joint += m as u32;
         cycles.push(CycleSummary {
@@ -784,6 +784,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
             ribbon_notes.tight_corners
         ));
     }
+    panels.shrink_to_fit();
     Ok(SchemeOutput {
         panels,
         connections: joint as usize,

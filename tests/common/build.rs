@@ -509,6 +509,9 @@ pub struct Pipeline {
     pub split: SplitReport,
     /// The scheme's output (3D panels, connections, notes).
     pub output: SchemeOutput,
+    /// The 3D panels as owned values, in the same order (the output keeps them in
+    /// one arena; tests index and zip them).
+    pub panels: Vec<Panel>,
     /// The panels unrolled, in the same order.
     pub flat: Vec<FlatPanel>,
 }
@@ -520,8 +523,8 @@ pub fn pipeline(job: &Job) -> Pipeline {
     let unfold::run::SchemeMesh { mesh, split, .. } =
         unfold::run::scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh");
     let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
-    let flat = output
-        .panels
+    let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_owned()).collect();
+    let flat = panels
         .iter()
         .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
         .collect();
@@ -529,6 +532,7 @@ pub fn pipeline(job: &Job) -> Pipeline {
         mesh,
         split,
         output,
+        panels,
         flat,
     }
 }
@@ -545,7 +549,7 @@ pub fn frames_of(panels: &[Panel]) -> Vec<Vec<FacetFrame>> {
 /// and the flat panels.
 pub fn panels_of(job: &Job) -> (Mesh, usize, Vec<Panel>, Vec<FlatPanel>) {
     let p = pipeline(job);
-    (p.mesh, p.output.connections, p.output.panels, p.flat)
+    (p.mesh, p.output.connections, p.panels, p.flat)
 }
 
 /// Build options for `scheme` at `--size size --holes holes --out out` (the rest at
