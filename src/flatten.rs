@@ -10,7 +10,9 @@ use glam::{DVec2, DVec3};
 
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
-use crate::panel::{make_in_order, FacetFrame, FlatHole, FlatPanel, FlatPanels, PanelRef, Panels};
+use crate::panel::{
+    fill_arena, Arena, FacetFrame, FlatHole, FlatPanel, FlatPanels, PanelRef, Panels,
+};
 use crate::plane::loop_signed_area;
 
 /// Why a panel cannot be unrolled (a bug in the scheme that made it).
@@ -225,22 +227,31 @@ pub fn unroll_all(
     panels: &Panels,
     options: LabelOptions,
 ) -> Result<(FlatPanels, LeftOut), FlattenError> {
-    // A flat panel has the 3D panel's vertices as points, so that buffer's size is
-    // known; the others grow and are trimmed at the end.
-    let mut flat = FlatPanels::with_capacity(panels.len(), panels.vertex_count());
-    let mut left_out = LeftOut::default();
-    make_in_order(
-        panels.len(),
-        |i| unroll_and_fit(panels.get(i), options),
-        |result| {
-            let (panel, dropped) = result?;
-            flat.push(panel.view());
-            left_out = left_out + dropped;
-            Ok(())
-        },
-    )?;
+    let Unrolled { mut flat, left_out } =
+        fill_arena(panels.len(), |i| unroll_and_fit(panels.get(i), options))?;
     flat.shrink_to_fit();
     Ok((flat, left_out))
+}
+
+/// Flat panels and the labels left out on them, as [`unroll_all`] collects them.
+#[derive(Default)]
+struct Unrolled {
+    flat: FlatPanels,
+    left_out: LeftOut,
+}
+
+impl Arena for Unrolled {
+    type Made = (FlatPanel, LeftOut);
+
+    fn take(&mut self, (panel, left_out): (FlatPanel, LeftOut)) {
+        self.flat.take(panel);
+        self.left_out = self.left_out + left_out;
+    }
+
+    fn append(&mut self, other: Unrolled) {
+        self.flat.append(other.flat);
+        self.left_out = self.left_out + other.left_out;
+    }
 }
 
 /// Chains the edges used by one facet into loops, outer (largest area, counter-

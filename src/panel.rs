@@ -459,9 +459,50 @@ pub struct Panels {
     labels: Vec<Label>,
 }
 
-/// Items made at a time by [`make_in_order`]: enough to keep the cores busy, few
-/// enough that the owned panels waiting to go into an arena stay a small part of it.
+/// Items made at a time by [`make_in_order`] and [`fill_arena`]: enough to keep the
+/// cores busy, few enough that what waits to be taken stays a small part of the whole.
 const CHUNK: usize = 1 << 14;
+
+/// An arena that panels are copied into (see [`fill_arena`]).
+pub(crate) trait Arena: Default + Send {
+    /// What one panel is made as.
+    type Made;
+    /// Copies one made panel in.
+    fn take(&mut self, made: Self::Made);
+    /// Appends another arena's panels after this one's.
+    fn append(&mut self, other: Self);
+}
+
+/// Makes `make(0)`, …, `make(count - 1)` in parallel and copies them into one arena in
+/// that order: each worker copies its own run of panels into a small arena of its
+/// own, as it makes them, and the runs are appended in order (bulk copies), so the
+/// copying is parallel and the thread count changes nothing. Works a chunk at a time,
+/// so the runs waiting to be appended stay small. On failure the error is the first
+/// one in order.
+pub(crate) fn fill_arena<A: Arena, E: Send>(
+    count: usize,
+    make: impl Fn(usize) -> Result<A::Made, E> + Sync,
+) -> Result<A, E> {
+    use rayon::prelude::*;
+    let mut all = A::default();
+    for start in (0..count).step_by(CHUNK) {
+        let runs: Vec<Result<A, E>> = (start..(start + CHUNK).min(count))
+            .into_par_iter()
+            .fold(
+                || Ok(A::default()),
+                |run, i| {
+                    let mut run = run?;
+                    run.take(make(i)?);
+                    Ok(run)
+                },
+            )
+            .collect();
+        for run in runs {
+            all.append(run?);
+        }
+    }
+    Ok(all)
+}
 
 /// Makes `make(0)`, …, `make(count - 1)` in parallel, a chunk at a time, and hands
 /// them to `take` in that order (so the thread count changes nothing); `take` of one
@@ -504,13 +545,8 @@ impl Panels {
     /// Panels `make(0)`, …, `make(count - 1)`, made in parallel a chunk at a time and
     /// stored in that order (so the thread count changes nothing).
     pub fn build(count: usize, make: impl Fn(usize) -> Panel + Sync) -> Self {
-        let mut all = Panels::new();
-        all.heads.reserve_exact(count);
-        let done: Result<(), std::convert::Infallible> = make_in_order(count, make, |panel| {
-            all.push(panel.view());
-            Ok(())
-        });
-        let Ok(()) = done;
+        let built: Result<Panels, std::convert::Infallible> = fill_arena(count, |i| Ok(make(i)));
+        let Ok(mut all) = built;
         all.shrink_to_fit();
         all
     }
@@ -607,6 +643,46 @@ impl Panels {
             panels: self,
             range: 0..self.len(),
         }
+    }
+}
+
+impl Arena for Panels {
+    type Made = Panel;
+
+    fn take(&mut self, made: Panel) {
+        self.push(made.view());
+    }
+
+    fn append(&mut self, other: Panels) {
+        let base = |len: usize| u32::try_from(len).expect("fewer than 2^32 panel items");
+        let offset = PanelStarts {
+            vertices: base(self.vertices.len()),
+            facet_indices: base(self.facet_indices.len()),
+            facet_ends: base(self.facet_ends.len()),
+            holes: base(self.holes.len()),
+            labels: base(self.labels.len()),
+        };
+        self.heads.extend(other.heads.iter().map(|head| PanelHead {
+            starts: PanelStarts {
+                vertices: head.starts.vertices + offset.vertices,
+                facet_indices: head.starts.facet_indices + offset.facet_indices,
+                facet_ends: head.starts.facet_ends + offset.facet_ends,
+                holes: head.starts.holes + offset.holes,
+                labels: head.starts.labels + offset.labels,
+            },
+            ..*head
+        }));
+        self.vertices.extend_from_slice(&other.vertices);
+        self.facet_indices.extend_from_slice(&other.facet_indices);
+        self.facet_ends.extend_from_slice(&other.facet_ends);
+        self.holes.extend_from_slice(&other.holes);
+        self.labels.extend_from_slice(&other.labels);
+        base(
+            self.vertices
+                .len()
+                .max(self.facet_indices.len())
+                .max(self.labels.len()),
+        );
     }
 }
 
@@ -902,15 +978,6 @@ impl FlatPanels {
         Self::default()
     }
 
-    /// No panels, with room for `panels` panels of `points` points in all.
-    pub fn with_capacity(panels: usize, points: usize) -> Self {
-        FlatPanels {
-            heads: Vec::with_capacity(panels),
-            points: Vec::with_capacity(points),
-            ..Self::default()
-        }
-    }
-
     /// Number of panels.
     pub fn len(&self) -> usize {
         self.heads.len()
@@ -1039,6 +1106,49 @@ impl<'a> IntoIterator for &'a FlatPanels {
     type IntoIter = FlatPanelsIter<'a>;
     fn into_iter(self) -> FlatPanelsIter<'a> {
         self.iter()
+    }
+}
+
+impl Arena for FlatPanels {
+    type Made = FlatPanel;
+
+    fn take(&mut self, made: FlatPanel) {
+        self.push(made.view());
+    }
+
+    fn append(&mut self, other: FlatPanels) {
+        let base = |len: usize| u32::try_from(len).expect("fewer than 2^32 flat items");
+        let offset = FlatStarts {
+            points: base(self.points.len()),
+            loop_indices: base(self.loop_indices.len()),
+            loop_ends: base(self.loop_ends.len()),
+            scores: base(self.scores.len()),
+            holes: base(self.holes.len()),
+            labels: base(self.labels.len()),
+        };
+        self.heads.extend(other.heads.iter().map(|head| FlatHead {
+            starts: FlatStarts {
+                points: head.starts.points + offset.points,
+                loop_indices: head.starts.loop_indices + offset.loop_indices,
+                loop_ends: head.starts.loop_ends + offset.loop_ends,
+                scores: head.starts.scores + offset.scores,
+                holes: head.starts.holes + offset.holes,
+                labels: head.starts.labels + offset.labels,
+            },
+            ..*head
+        }));
+        self.points.extend_from_slice(&other.points);
+        self.loop_indices.extend_from_slice(&other.loop_indices);
+        self.loop_ends.extend_from_slice(&other.loop_ends);
+        self.scores.extend_from_slice(&other.scores);
+        self.holes.extend_from_slice(&other.holes);
+        self.labels.extend_from_slice(&other.labels);
+        base(
+            self.points
+                .len()
+                .max(self.loop_indices.len())
+                .max(self.labels.len()),
+        );
     }
 }
 
@@ -1173,6 +1283,9 @@ mod tests {
             assert_eq!(got.outline.len(), 1 + k % 2);
         }
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
+        // What a panel costs beside its items (the README's figure).
+        assert_eq!(std::mem::size_of::<PanelHead>(), 56);
+        assert_eq!(std::mem::size_of::<FlatHead>(), 56);
     }
 
     #[test]
@@ -1184,7 +1297,12 @@ mod tests {
         for i in [0, CHUNK - 1, CHUNK, 2 * CHUNK + 4] {
             assert_eq!(arena.get(i), fan(i as u32 % 5).view(), "panel {i}");
         }
-        // The first error in order wins, and nothing after it is taken.
+        // The first error in order wins, whichever worker met it first.
+        let fails_late = |i: usize| i % 1000 == 999 && i > CHUNK;
+        let failed: Result<Panels, usize> =
+            fill_arena(count, |i| if fails_late(i) { Err(i) } else { Ok(fan(0)) });
+        assert_eq!(failed.err(), Some(16_999));
+        // And with make_in_order nothing after it is taken.
         let mut taken = Vec::new();
         let failed = make_in_order(
             count,
