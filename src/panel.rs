@@ -189,12 +189,6 @@ impl Loops {
     pub fn index_count(&self) -> usize {
         self.indices.len()
     }
-
-    /// Gives back spare capacity (panels are built once and kept).
-    pub fn shrink_to_fit(&mut self) {
-        self.indices.shrink_to_fit();
-        self.ends.shrink_to_fit();
-    }
 }
 
 impl std::ops::Index<usize> for Loops {
@@ -340,23 +334,19 @@ pub struct Panel {
 }
 
 impl Panel {
-    /// A panel from its parts, holding no spare capacity: the schemes build panels by
-    /// pushing, and a big job keeps millions of them until the end. Labels whose text
-    /// box at the smallest legible height has more area than any facet they may go on
-    /// are dropped here (and counted): at a million panels they would take more memory
-    /// than the panels' geometry, and fitting would leave them out anyway.
+    /// A panel from its parts. Labels whose text box at the smallest legible height
+    /// has more area than any facet they may go on are dropped here (and counted): at
+    /// a million panels they would take more memory than the panels' geometry, and
+    /// fitting would leave them out anyway. (Spare capacity is not trimmed: a job's
+    /// panels are copied into a [`Panels`] arena as they are made.)
     pub fn new(
         source: Source,
-        mut vertices: Vec<DVec3>,
-        mut facets: Loops,
-        mut holes: Vec<Hole>,
+        vertices: Vec<DVec3>,
+        facets: Loops,
+        holes: Vec<Hole>,
         mut labels: Vec<Label>,
     ) -> Self {
         let labels_dropped = crate::labels::drop_unfittable(&vertices, facets.view(), &mut labels);
-        vertices.shrink_to_fit();
-        facets.shrink_to_fit();
-        holes.shrink_to_fit();
-        labels.shrink_to_fit();
         Panel {
             source,
             vertices,
@@ -416,7 +406,7 @@ impl PanelRef<'_> {
     }
 
     /// An owned copy.
-    pub fn to_owned(&self) -> Panel {
+    pub fn to_panel(&self) -> Panel {
         Panel {
             source: self.source,
             vertices: self.vertices.to_vec(),
@@ -463,6 +453,15 @@ pub struct Panels {
 /// cores busy, few enough that what waits to be taken stays a small part of the whole.
 const CHUNK: usize = 1 << 14;
 
+/// A buffer length as an arena's u32 start.
+///
+/// # Panics
+/// When it passes 2³² items: about 100 GB of 3D vertices or 70 GB of flat points,
+/// far beyond what the machines the tool runs on hold.
+fn arena_len(len: usize) -> u32 {
+    u32::try_from(len).expect("an arena buffer of fewer than 2^32 items")
+}
+
 /// An arena that panels are copied into (see [`fill_arena`]).
 pub(crate) trait Arena: Default + Send {
     /// What one panel is made as.
@@ -507,8 +506,8 @@ pub(crate) fn fill_arena<A: Arena, E: Send>(
 /// Makes `make(0)`, …, `make(count - 1)` in parallel, a chunk at a time, and hands
 /// them to `take` in that order (so the thread count changes nothing); `take` of one
 /// chunk runs while the next chunk is made. Stops at the first error `take` returns.
-/// This is how the arenas are filled: panels are made as owned values, in parallel,
-/// and copied into the arena in order, without ever holding them all.
+/// For results that go into something other than an [`Arena`] (the half-edge
+/// scheme's sparse tabs), without ever holding them all.
 pub(crate) fn make_in_order<T: Send, E: Send>(
     count: usize,
     make: impl Fn(usize) -> T + Sync,
@@ -566,29 +565,32 @@ impl Panels {
     /// # Panics
     /// When a buffer would pass 2³² items (about 100 GB of vertices alone).
     pub fn push(&mut self, panel: PanelRef<'_>) {
-        let start = |len: usize| u32::try_from(len).expect("fewer than 2^32 panel items");
-        self.heads.push(PanelHead {
-            source: panel.source,
-            starts: PanelStarts {
-                vertices: start(self.vertices.len()),
-                facet_indices: start(self.facet_indices.len()),
-                facet_ends: start(self.facet_ends.len()),
-                holes: start(self.holes.len()),
-                labels: start(self.labels.len()),
-            },
-            labels_dropped: panel.labels_dropped,
-        });
+        let starts = self.lens();
         self.vertices.extend_from_slice(panel.vertices);
         self.facet_indices.extend_from_slice(panel.facets.indices);
         self.facet_ends.extend_from_slice(panel.facets.ends);
         self.holes.extend_from_slice(panel.holes);
         self.labels.extend_from_slice(panel.labels);
-        start(
-            self.vertices
-                .len()
-                .max(self.facet_indices.len())
-                .max(self.labels.len()),
-        );
+        self.lens();
+        self.heads.push(PanelHead {
+            source: panel.source,
+            starts,
+            labels_dropped: panel.labels_dropped,
+        });
+    }
+
+    /// The length of every buffer: where the next panel's items start.
+    ///
+    /// # Panics
+    /// When a buffer has passed 2³² items.
+    fn lens(&self) -> PanelStarts {
+        PanelStarts {
+            vertices: arena_len(self.vertices.len()),
+            facet_indices: arena_len(self.facet_indices.len()),
+            facet_ends: arena_len(self.facet_ends.len()),
+            holes: arena_len(self.holes.len()),
+            labels: arena_len(self.labels.len()),
+        }
     }
 
     /// Gives back spare capacity (the arena is filled once and kept).
@@ -601,11 +603,6 @@ impl Panels {
         self.labels.shrink_to_fit();
     }
 
-    /// Vertices of all panels together.
-    pub fn vertex_count(&self) -> usize {
-        self.vertices.len()
-    }
-
     /// Panel `i`.
     ///
     /// # Panics
@@ -613,16 +610,10 @@ impl Panels {
     pub fn get(&self, i: usize) -> PanelRef<'_> {
         let head = &self.heads[i];
         let start = head.starts;
-        let end = self.heads.get(i + 1).map_or(
-            PanelStarts {
-                vertices: self.vertices.len() as u32,
-                facet_indices: self.facet_indices.len() as u32,
-                facet_ends: self.facet_ends.len() as u32,
-                holes: self.holes.len() as u32,
-                labels: self.labels.len() as u32,
-            },
-            |next| next.starts,
-        );
+        let end = self
+            .heads
+            .get(i + 1)
+            .map_or_else(|| self.lens(), |next| next.starts);
         let range = |a: u32, b: u32| a as usize..b as usize;
         PanelRef {
             source: head.source,
@@ -654,35 +645,27 @@ impl Arena for Panels {
     }
 
     fn append(&mut self, other: Panels) {
-        let base = |len: usize| u32::try_from(len).expect("fewer than 2^32 panel items");
-        let offset = PanelStarts {
-            vertices: base(self.vertices.len()),
-            facet_indices: base(self.facet_indices.len()),
-            facet_ends: base(self.facet_ends.len()),
-            holes: base(self.holes.len()),
-            labels: base(self.labels.len()),
-        };
-        self.heads.extend(other.heads.iter().map(|head| PanelHead {
-            starts: PanelStarts {
-                vertices: head.starts.vertices + offset.vertices,
-                facet_indices: head.starts.facet_indices + offset.facet_indices,
-                facet_ends: head.starts.facet_ends + offset.facet_ends,
-                holes: head.starts.holes + offset.holes,
-                labels: head.starts.labels + offset.labels,
-            },
-            ..*head
-        }));
+        let offset = self.lens();
         self.vertices.extend_from_slice(&other.vertices);
         self.facet_indices.extend_from_slice(&other.facet_indices);
         self.facet_ends.extend_from_slice(&other.facet_ends);
         self.holes.extend_from_slice(&other.holes);
         self.labels.extend_from_slice(&other.labels);
-        base(
-            self.vertices
-                .len()
-                .max(self.facet_indices.len())
-                .max(self.labels.len()),
-        );
+        // Checked before the shift: no shifted start can pass the new lengths.
+        self.lens();
+        self.heads.extend(other.heads.iter().map(|head| {
+            let s = head.starts;
+            PanelHead {
+                starts: PanelStarts {
+                    vertices: s.vertices + offset.vertices,
+                    facet_indices: s.facet_indices + offset.facet_indices,
+                    facet_ends: s.facet_ends + offset.facet_ends,
+                    holes: s.holes + offset.holes,
+                    labels: s.labels + offset.labels,
+                },
+                ..*head
+            }
+        }));
     }
 }
 
@@ -909,20 +892,8 @@ impl FlatPanelRef<'_> {
         self.loop_points(&self.outline[0])
     }
 
-    /// Largest distance between two points of the panel (its size).
-    pub fn diameter(&self) -> f64 {
-        let outer = self.outer();
-        let mut best = 0.0f64;
-        for (i, a) in outer.iter().enumerate() {
-            for b in &outer[i + 1..] {
-                best = best.max(a.distance_squared(*b));
-            }
-        }
-        best.sqrt()
-    }
-
     /// An owned copy.
-    pub fn to_owned(&self) -> FlatPanel {
+    pub fn to_flat_panel(&self) -> FlatPanel {
         FlatPanel {
             source: self.source,
             points: self.points.to_vec(),
@@ -959,7 +930,7 @@ struct FlatHead {
 /// The flat panels of a job, all in one arena: one buffer per kind of item (points,
 /// outline indices, scores, holes, labels) and a small head per panel saying where
 /// its items start. A big job has millions of flat panels of a dozen points each; as
-/// separate [`FlatPanel`]s they cost four allocations and a 200-byte struct apiece,
+/// separate [`FlatPanel`]s they cost four allocations and a 176-byte struct apiece,
 /// more than their points. Panels are handed out as [`FlatPanelRef`]s.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct FlatPanels {
@@ -993,33 +964,35 @@ impl FlatPanels {
     /// # Panics
     /// When a buffer would pass 2³² items (about 70 GB of points alone).
     pub fn push(&mut self, panel: FlatPanelRef<'_>) {
-        let start = |len: usize| u32::try_from(len).expect("fewer than 2^32 flat items");
-        self.heads.push(FlatHead {
-            source: panel.source,
-            starts: FlatStarts {
-                points: start(self.points.len()),
-                loop_indices: start(self.loop_indices.len()),
-                loop_ends: start(self.loop_ends.len()),
-                scores: start(self.scores.len()),
-                holes: start(self.holes.len()),
-                labels: start(self.labels.len()),
-            },
-            developability_error: panel.developability_error,
-            area: panel.area,
-        });
+        let starts = self.lens();
         self.points.extend_from_slice(panel.points);
         self.loop_indices.extend_from_slice(panel.outline.indices);
         self.loop_ends.extend_from_slice(panel.outline.ends);
         self.scores.extend_from_slice(panel.scores);
         self.holes.extend_from_slice(panel.holes);
         self.labels.extend_from_slice(panel.labels);
-        // Checked once per panel: the buffers only grow, so the last start bounds all.
-        start(
-            self.points
-                .len()
-                .max(self.loop_indices.len())
-                .max(self.labels.len()),
-        );
+        self.lens();
+        self.heads.push(FlatHead {
+            source: panel.source,
+            starts,
+            developability_error: panel.developability_error,
+            area: panel.area,
+        });
+    }
+
+    /// The length of every buffer: where the next panel's items start.
+    ///
+    /// # Panics
+    /// When a buffer has passed 2³² items.
+    fn lens(&self) -> FlatStarts {
+        FlatStarts {
+            points: arena_len(self.points.len()),
+            loop_indices: arena_len(self.loop_indices.len()),
+            loop_ends: arena_len(self.loop_ends.len()),
+            scores: arena_len(self.scores.len()),
+            holes: arena_len(self.holes.len()),
+            labels: arena_len(self.labels.len()),
+        }
     }
 
     /// Gives back spare capacity (the arena is filled once and kept).
@@ -1040,17 +1013,10 @@ impl FlatPanels {
     pub fn get(&self, i: usize) -> FlatPanelRef<'_> {
         let head = &self.heads[i];
         let start = head.starts;
-        let end = self.heads.get(i + 1).map_or(
-            FlatStarts {
-                points: self.points.len() as u32,
-                loop_indices: self.loop_indices.len() as u32,
-                loop_ends: self.loop_ends.len() as u32,
-                scores: self.scores.len() as u32,
-                holes: self.holes.len() as u32,
-                labels: self.labels.len() as u32,
-            },
-            |next| next.starts,
-        );
+        let end = self
+            .heads
+            .get(i + 1)
+            .map_or_else(|| self.lens(), |next| next.starts);
         let range = |a: u32, b: u32| a as usize..b as usize;
         FlatPanelRef {
             source: head.source,
@@ -1117,38 +1083,29 @@ impl Arena for FlatPanels {
     }
 
     fn append(&mut self, other: FlatPanels) {
-        let base = |len: usize| u32::try_from(len).expect("fewer than 2^32 flat items");
-        let offset = FlatStarts {
-            points: base(self.points.len()),
-            loop_indices: base(self.loop_indices.len()),
-            loop_ends: base(self.loop_ends.len()),
-            scores: base(self.scores.len()),
-            holes: base(self.holes.len()),
-            labels: base(self.labels.len()),
-        };
-        self.heads.extend(other.heads.iter().map(|head| FlatHead {
-            starts: FlatStarts {
-                points: head.starts.points + offset.points,
-                loop_indices: head.starts.loop_indices + offset.loop_indices,
-                loop_ends: head.starts.loop_ends + offset.loop_ends,
-                scores: head.starts.scores + offset.scores,
-                holes: head.starts.holes + offset.holes,
-                labels: head.starts.labels + offset.labels,
-            },
-            ..*head
-        }));
+        let offset = self.lens();
         self.points.extend_from_slice(&other.points);
         self.loop_indices.extend_from_slice(&other.loop_indices);
         self.loop_ends.extend_from_slice(&other.loop_ends);
         self.scores.extend_from_slice(&other.scores);
         self.holes.extend_from_slice(&other.holes);
         self.labels.extend_from_slice(&other.labels);
-        base(
-            self.points
-                .len()
-                .max(self.loop_indices.len())
-                .max(self.labels.len()),
-        );
+        // Checked before the shift: no shifted start can pass the new lengths.
+        self.lens();
+        self.heads.extend(other.heads.iter().map(|head| {
+            let s = head.starts;
+            FlatHead {
+                starts: FlatStarts {
+                    points: s.points + offset.points,
+                    loop_indices: s.loop_indices + offset.loop_indices,
+                    loop_ends: s.loop_ends + offset.loop_ends,
+                    scores: s.scores + offset.scores,
+                    holes: s.holes + offset.holes,
+                    labels: s.labels + offset.labels,
+                },
+                ..*head
+            }
+        }));
     }
 }
 
@@ -1262,10 +1219,9 @@ mod tests {
         let owned: Vec<Panel> = (0..7).map(fan).collect();
         let arena: Panels = owned.iter().cloned().collect();
         assert_eq!(arena.len(), 7);
-        assert_eq!(arena.vertex_count(), (3..10).sum::<usize>());
         for (k, (got, want)) in arena.iter().zip(&owned).enumerate() {
             assert_eq!(got, want.view(), "panel {k}");
-            assert_eq!(&got.to_owned(), want, "panel {k}");
+            assert_eq!(&got.to_panel(), want, "panel {k}");
             assert_eq!(got.facets.len(), k + 1);
         }
         assert_eq!(
@@ -1278,14 +1234,17 @@ mod tests {
         assert_eq!(flat.len(), 7);
         for (k, (got, want)) in flat.iter().zip(&flat_owned).enumerate() {
             assert_eq!(got, want.view(), "flat panel {k}");
-            assert_eq!(&got.to_owned(), want, "flat panel {k}");
+            assert_eq!(&got.to_flat_panel(), want, "flat panel {k}");
             assert_eq!(got.outer(), want.outer());
             assert_eq!(got.outline.len(), 1 + k % 2);
         }
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
-        // What a panel costs beside its items (the README's figure).
+        // What a panel costs beside its items, against an owned panel's struct (the
+        // README's figures).
         assert_eq!(std::mem::size_of::<PanelHead>(), 56);
         assert_eq!(std::mem::size_of::<FlatHead>(), 56);
+        assert_eq!(std::mem::size_of::<Panel>(), 160);
+        assert_eq!(std::mem::size_of::<FlatPanel>(), 176);
     }
 
     #[test]
@@ -1294,8 +1253,14 @@ mod tests {
         let count = 2 * CHUNK + 5;
         let arena = Panels::build(count, |i| fan(i as u32 % 5));
         assert_eq!(arena.len(), count);
-        for i in [0, CHUNK - 1, CHUNK, 2 * CHUNK + 4] {
-            assert_eq!(arena.get(i), fan(i as u32 % 5).view(), "panel {i}");
+        for (i, panel) in arena.iter().enumerate() {
+            assert_eq!(panel, fan(i as u32 % 5).view(), "panel {i}");
+        }
+        let flat: Result<FlatPanels, ()> = fill_arena(count, |i| Ok(flat_fan(i as u32 % 7)));
+        let flat = flat.expect("no errors");
+        assert_eq!(flat.len(), count);
+        for (i, panel) in flat.iter().enumerate() {
+            assert_eq!(panel, flat_fan(i as u32 % 7).view(), "flat panel {i}");
         }
         // The first error in order wins, whichever worker met it first.
         let fails_late = |i: usize| i % 1000 == 999 && i > CHUNK;

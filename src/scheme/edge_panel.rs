@@ -286,7 +286,7 @@ fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
 
 /// The panel of edge `e`: flap in f, bend strips, flap in f′ (or the flap alone on the
 /// boundary). Every buffer is sized exactly before it is filled: a big job builds
-/// millions of panels and keeps them all.
+/// millions of panels, and none should grow twice.
 fn edge_panel(
     mesh: &Mesh,
     e: EdgeId,

@@ -523,7 +523,7 @@ pub fn pipeline(job: &Job) -> Pipeline {
     let unfold::run::SchemeMesh { mesh, split, .. } =
         unfold::run::scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh");
     let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
-    let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_owned()).collect();
+    let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
     let flat = panels
         .iter()
         .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
