@@ -55,6 +55,8 @@ fn main() -> anyhow::Result<()> {
     drop(raw);
     lap("split");
     let output = unfold::scheme::build_panels(scheme, &scheme_mesh.mesh, &job.scheme_options)?;
+    // As the pipeline does (memory.rs).
+    unfold::memory::release_freed();
     lap("scheme");
     // The pipeline's flatten stage: unrolling and label fitting.
     let (flat, _) = unroll_all(&output.panels, LabelOptions::default())?;

@@ -15,6 +15,7 @@ pub mod export;
 pub mod flatten;
 pub mod font;
 pub mod labels;
+pub mod memory;
 pub mod mesh;
 pub mod nest;
 pub mod panel;

@@ -202,6 +202,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         }
     })?;
     notes.extend(output.notes.iter().cloned());
+    crate::memory::release_freed();
     clock.lap("scheme");
 
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
