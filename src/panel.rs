@@ -462,15 +462,77 @@ fn arena_len(len: usize) -> u32 {
     u32::try_from(len).expect("an arena buffer of fewer than 2^32 items")
 }
 
-/// An arena that panels are copied into (see [`fill_arena`]).
-pub(crate) trait Arena: Default + Send {
+/// Something panels are copied into as they are made (see [`fill_arena`]): the
+/// arenas, and whatever gathers them with a tally.
+pub trait Arena: Default + Send {
     /// What one panel is made as.
     type Made;
     /// Copies one made panel in.
     fn take(&mut self, made: Self::Made);
-    /// Appends another arena's panels after this one's.
+    /// Appends another one's panels after this one's.
     fn append(&mut self, other: Self);
 }
+
+/// An arena that hands its panels out as views ([`Panels`], [`FlatPanels`]).
+pub trait Views {
+    /// How a panel is handed out.
+    type View<'a>
+    where
+        Self: 'a;
+    /// Number of panels.
+    fn count(&self) -> usize;
+    /// Panel `i` (panics when there is none, as indexing does).
+    fn view(&self, i: usize) -> Self::View<'_>;
+}
+
+/// An arena of the panels `made`, in order.
+fn collect_arena<A: Arena>(made: impl IntoIterator<Item = A::Made>) -> A {
+    let mut all = A::default();
+    for panel in made {
+        all.take(panel);
+    }
+    all
+}
+
+/// The panels of an arena, in order.
+#[derive(Clone, Debug)]
+pub struct ArenaIter<'a, A> {
+    arena: &'a A,
+    range: std::ops::Range<usize>,
+}
+
+impl<'a, A: Views> ArenaIter<'a, A> {
+    fn new(arena: &'a A) -> Self {
+        ArenaIter {
+            arena,
+            range: 0..arena.count(),
+        }
+    }
+}
+
+impl<'a, A: Views> Iterator for ArenaIter<'a, A> {
+    type Item = A::View<'a>;
+    fn next(&mut self) -> Option<A::View<'a>> {
+        self.range.next().map(|i| self.arena.view(i))
+    }
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        self.range.size_hint()
+    }
+}
+
+impl<A: Views> DoubleEndedIterator for ArenaIter<'_, A> {
+    fn next_back(&mut self) -> Option<Self::Item> {
+        self.range.next_back().map(|i| self.arena.view(i))
+    }
+}
+
+impl<A: Views> ExactSizeIterator for ArenaIter<'_, A> {}
+
+/// The panels of a [`Panels`], in order.
+pub type PanelsIter<'a> = ArenaIter<'a, Panels>;
+
+/// The panels of a [`FlatPanels`], in order.
+pub type FlatPanelsIter<'a> = ArenaIter<'a, FlatPanels>;
 
 /// Makes `make(0)`, …, `make(count - 1)` in parallel and copies them into one arena in
 /// that order: each worker copies its own run of panels into a small arena of its
@@ -478,7 +540,7 @@ pub(crate) trait Arena: Default + Send {
 /// copying is parallel and the thread count changes nothing. Works a chunk at a time,
 /// so the runs waiting to be appended stay small. On failure the error is the first
 /// one in order.
-pub(crate) fn fill_arena<A: Arena, E: Send>(
+pub fn fill_arena<A: Arena, E: Send>(
     count: usize,
     make: impl Fn(usize) -> Result<A::Made, E> + Sync,
 ) -> Result<A, E> {
@@ -630,10 +692,19 @@ impl Panels {
 
     /// The panels in order.
     pub fn iter(&self) -> PanelsIter<'_> {
-        PanelsIter {
-            panels: self,
-            range: 0..self.len(),
-        }
+        ArenaIter::new(self)
+    }
+}
+
+impl Views for Panels {
+    type View<'a> = PanelRef<'a>;
+
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn view(&self, i: usize) -> PanelRef<'_> {
+        self.get(i)
     }
 }
 
@@ -671,39 +742,11 @@ impl Arena for Panels {
 
 impl FromIterator<Panel> for Panels {
     fn from_iter<I: IntoIterator<Item = Panel>>(panels: I) -> Self {
-        let mut all = Panels::new();
-        for panel in panels {
-            all.push(panel.view());
-        }
+        let mut all: Panels = collect_arena(panels);
         all.shrink_to_fit();
         all
     }
 }
-
-/// The panels of a [`Panels`], in order.
-#[derive(Clone, Debug)]
-pub struct PanelsIter<'a> {
-    panels: &'a Panels,
-    range: std::ops::Range<usize>,
-}
-
-impl<'a> Iterator for PanelsIter<'a> {
-    type Item = PanelRef<'a>;
-    fn next(&mut self) -> Option<PanelRef<'a>> {
-        self.range.next().map(|i| self.panels.get(i))
-    }
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        self.range.size_hint()
-    }
-}
-
-impl DoubleEndedIterator for PanelsIter<'_> {
-    fn next_back(&mut self) -> Option<Self::Item> {
-        self.range.next_back().map(|i| self.panels.get(i))
-    }
-}
-
-impl ExactSizeIterator for PanelsIter<'_> {}
 
 impl<'a> IntoIterator for &'a Panels {
     type Item = PanelRef<'a>;
@@ -1035,43 +1078,27 @@ impl FlatPanels {
 
     /// The panels in order.
     pub fn iter(&self) -> FlatPanelsIter<'_> {
-        FlatPanelsIter {
-            panels: self,
-            range: 0..self.len(),
-        }
+        ArenaIter::new(self)
     }
 }
-
-/// The panels of a [`FlatPanels`], in order.
-#[derive(Clone, Debug)]
-pub struct FlatPanelsIter<'a> {
-    panels: &'a FlatPanels,
-    range: std::ops::Range<usize>,
-}
-
-impl<'a> Iterator for FlatPanelsIter<'a> {
-    type Item = FlatPanelRef<'a>;
-    fn next(&mut self) -> Option<FlatPanelRef<'a>> {
-        self.range.next().map(|i| self.panels.get(i))
-    }
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        self.range.size_hint()
-    }
-}
-
-impl DoubleEndedIterator for FlatPanelsIter<'_> {
-    fn next_back(&mut self) -> Option<Self::Item> {
-        self.range.next_back().map(|i| self.panels.get(i))
-    }
-}
-
-impl ExactSizeIterator for FlatPanelsIter<'_> {}
 
 impl<'a> IntoIterator for &'a FlatPanels {
     type Item = FlatPanelRef<'a>;
     type IntoIter = FlatPanelsIter<'a>;
     fn into_iter(self) -> FlatPanelsIter<'a> {
         self.iter()
+    }
+}
+
+impl Views for FlatPanels {
+    type View<'a> = FlatPanelRef<'a>;
+
+    fn count(&self) -> usize {
+        self.len()
+    }
+
+    fn view(&self, i: usize) -> FlatPanelRef<'_> {
+        self.get(i)
     }
 }
 
@@ -1111,10 +1138,7 @@ impl Arena for FlatPanels {
 
 impl FromIterator<FlatPanel> for FlatPanels {
     fn from_iter<I: IntoIterator<Item = FlatPanel>>(panels: I) -> Self {
-        let mut all = FlatPanels::new();
-        for panel in panels {
-            all.push(panel.view());
-        }
+        let mut all: FlatPanels = collect_arena(panels);
         all.shrink_to_fit();
         all
     }
