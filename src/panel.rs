@@ -10,6 +10,11 @@ use serde::Serialize;
 
 use crate::labels::LeftOut;
 
+mod arena;
+
+use arena::{arena_len, collect_arena};
+pub use arena::{fill_arena, Arena, ArenaIter, Views};
+
 /// Which mesh element a panel was made from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -449,153 +454,11 @@ pub struct Panels {
     labels: Vec<Label>,
 }
 
-/// Items made at a time by [`make_in_order`] and [`fill_arena`]: enough to keep the
-/// cores busy, few enough that what waits to be taken stays a small part of the whole.
-const CHUNK: usize = 1 << 14;
-
-/// A buffer length as an arena's u32 start.
-///
-/// # Panics
-/// When it passes 2³² items: about 100 GB of 3D vertices or 70 GB of flat points,
-/// far beyond what the machines the tool runs on hold.
-fn arena_len(len: usize) -> u32 {
-    u32::try_from(len).expect("an arena buffer of fewer than 2^32 items")
-}
-
-/// Something panels are copied into as they are made (see [`fill_arena`]): the
-/// arenas, and whatever gathers them with a tally.
-pub trait Arena: Default + Send {
-    /// What one panel is made as.
-    type Made;
-    /// Copies one made panel in.
-    fn take(&mut self, made: Self::Made);
-    /// Appends another one's panels after this one's.
-    fn append(&mut self, other: Self);
-}
-
-/// An arena that hands its panels out as views ([`Panels`], [`FlatPanels`]).
-pub trait Views {
-    /// How a panel is handed out.
-    type View<'a>
-    where
-        Self: 'a;
-    /// Number of panels.
-    fn count(&self) -> usize;
-    /// Panel `i` (panics when there is none, as indexing does).
-    fn view(&self, i: usize) -> Self::View<'_>;
-}
-
-/// An arena of the panels `made`, in order.
-fn collect_arena<A: Arena>(made: impl IntoIterator<Item = A::Made>) -> A {
-    let mut all = A::default();
-    for panel in made {
-        all.take(panel);
-    }
-    all
-}
-
-/// The panels of an arena, in order.
-#[derive(Clone, Debug)]
-pub struct ArenaIter<'a, A> {
-    arena: &'a A,
-    range: std::ops::Range<usize>,
-}
-
-impl<'a, A: Views> ArenaIter<'a, A> {
-    fn new(arena: &'a A) -> Self {
-        ArenaIter {
-            arena,
-            range: 0..arena.count(),
-        }
-    }
-}
-
-impl<'a, A: Views> Iterator for ArenaIter<'a, A> {
-    type Item = A::View<'a>;
-    fn next(&mut self) -> Option<A::View<'a>> {
-        self.range.next().map(|i| self.arena.view(i))
-    }
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        self.range.size_hint()
-    }
-}
-
-impl<A: Views> DoubleEndedIterator for ArenaIter<'_, A> {
-    fn next_back(&mut self) -> Option<Self::Item> {
-        self.range.next_back().map(|i| self.arena.view(i))
-    }
-}
-
-impl<A: Views> ExactSizeIterator for ArenaIter<'_, A> {}
-
 /// The panels of a [`Panels`], in order.
 pub type PanelsIter<'a> = ArenaIter<'a, Panels>;
 
 /// The panels of a [`FlatPanels`], in order.
 pub type FlatPanelsIter<'a> = ArenaIter<'a, FlatPanels>;
-
-/// Makes `make(0)`, …, `make(count - 1)` in parallel and copies them into one arena in
-/// that order: each worker copies its own run of panels into a small arena of its
-/// own, as it makes them, and the runs are appended in order (bulk copies), so the
-/// copying is parallel and the thread count changes nothing. Works a chunk at a time,
-/// so the runs waiting to be appended stay small. On failure the error is the first
-/// one in order.
-pub fn fill_arena<A: Arena, E: Send>(
-    count: usize,
-    make: impl Fn(usize) -> Result<A::Made, E> + Sync,
-) -> Result<A, E> {
-    use rayon::prelude::*;
-    let mut all = A::default();
-    for start in (0..count).step_by(CHUNK) {
-        let runs: Vec<Result<A, E>> = (start..(start + CHUNK).min(count))
-            .into_par_iter()
-            .fold(
-                || Ok(A::default()),
-                |run, i| {
-                    let mut run = run?;
-                    run.take(make(i)?);
-                    Ok(run)
-                },
-            )
-            .collect();
-        for run in runs {
-            all.append(run?);
-        }
-    }
-    Ok(all)
-}
-
-/// Makes `make(0)`, …, `make(count - 1)` in parallel, a chunk at a time, and hands
-/// them to `take` in that order (so the thread count changes nothing); `take` of one
-/// chunk runs while the next chunk is made. Stops at the first error `take` returns.
-/// For results that go into something other than an [`Arena`] (the half-edge
-/// scheme's sparse tabs), without ever holding them all.
-pub(crate) fn make_in_order<T: Send, E: Send>(
-    count: usize,
-    make: impl Fn(usize) -> T + Sync,
-    mut take: impl FnMut(T) -> Result<(), E> + Send,
-) -> Result<(), E> {
-    use rayon::prelude::*;
-    let make_chunk = |start: usize| -> Vec<T> {
-        (start.min(count)..(start + CHUNK).min(count))
-            .into_par_iter()
-            .map(&make)
-            .collect()
-    };
-    let mut made = make_chunk(0);
-    let mut start = 0;
-    while !made.is_empty() {
-        let current = std::mem::take(&mut made);
-        let (next, taken) = rayon::join(
-            || make_chunk(start + CHUNK),
-            || current.into_iter().try_for_each(&mut take),
-        );
-        taken?;
-        made = next;
-        start += CHUNK;
-    }
-    Ok(())
-}
 
 impl Panels {
     /// No panels.
@@ -1146,6 +1009,7 @@ impl FromIterator<FlatPanel> for FlatPanels {
 
 #[cfg(test)]
 mod tests {
+    use super::arena::CHUNK;
     use super::*;
 
     #[test]
@@ -1291,21 +1155,6 @@ mod tests {
         let failed: Result<Panels, usize> =
             fill_arena(count, |i| if fails_late(i) { Err(i) } else { Ok(fan(0)) });
         assert_eq!(failed.err(), Some(16_999));
-        // And with make_in_order nothing after it is taken.
-        let mut taken = Vec::new();
-        let failed = make_in_order(
-            count,
-            |i| i,
-            |i| {
-                if i % 1000 == 999 && i > CHUNK {
-                    return Err(i);
-                }
-                taken.push(i);
-                Ok(())
-            },
-        );
-        assert_eq!(failed, Err(16_999));
-        assert_eq!(taken, (0..16_999).collect::<Vec<_>>());
     }
 
     #[test]

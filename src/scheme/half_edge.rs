@@ -12,7 +12,7 @@ use glam::{DVec2, DVec3};
 
 use super::{face_band, SchemeOptions, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
-use crate::panel::{make_in_order, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
@@ -36,6 +36,7 @@ struct Tab {
 /// The tabs of a mesh's edges, kept sparse: on a fine mesh most edges have none (the
 /// neighbour face is too small to hold one), and a slot the size of a tab per edge
 /// would cost more than the panels.
+#[derive(Default)]
 struct Tabs {
     /// Per edge, the index of its tab in `tabs`, or `NO_TAB`.
     slot: Vec<u32>,
@@ -46,9 +47,11 @@ struct Tabs {
 /// The slot of an edge without a tab.
 const NO_TAB: u32 = u32::MAX;
 
-impl Tabs {
+impl Arena for Tabs {
+    type Made = Option<Tab>;
+
     /// Appends the next edge's tab (or its lack of one).
-    fn push(&mut self, tab: Option<Tab>) {
+    fn take(&mut self, tab: Option<Tab>) {
         match tab {
             Some(tab) => {
                 // Fewer tabs than edges, and edge ids are u32.
@@ -59,6 +62,17 @@ impl Tabs {
         }
     }
 
+    fn append(&mut self, other: Tabs) {
+        let offset = self.tabs.len() as u32;
+        self.slot.extend(other.slot.iter().map(|&k| match k {
+            NO_TAB => NO_TAB,
+            k => k + offset,
+        }));
+        self.tabs.extend(other.tabs);
+    }
+}
+
+impl Tabs {
     /// The tab of edge `e`, if it has one.
     fn of_edge(&self, e: EdgeId) -> Option<&Tab> {
         match self.slot[e.index()] {
@@ -78,32 +92,22 @@ pub fn panel_id(f: FaceId) -> Name {
 pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
     // Tabs per edge (interior edges only), computed independently in parallel and
     // collected in edge order.
-    let mut tabs = Tabs {
-        slot: Vec::with_capacity(mesh.edge_count()),
-        tabs: Vec::new(),
-    };
-    let made: Result<(), std::convert::Infallible> = make_in_order(
-        mesh.edge_count(),
-        |e| {
-            let e = EdgeId(e as u32);
-            if !options.tabs || mesh.is_boundary_edge(e) {
-                return None;
-            }
-            // The owner alternates with the edge index: even edges give the tab to the
-            // face of half-edge 2e, odd edges to the face of 2e + 1.
-            let owner = if e.0.is_multiple_of(2) {
-                e.half_edge()
-            } else {
-                e.half_edge().twin()
-            };
-            make_tab(mesh, owner, options)
-        },
-        |tab| {
-            tabs.push(tab);
-            Ok(())
-        },
-    );
-    let Ok(()) = made;
+    let made: Result<Tabs, std::convert::Infallible> = fill_arena(mesh.edge_count(), |e| {
+        let e = EdgeId(e as u32);
+        if !options.tabs || mesh.is_boundary_edge(e) {
+            return Ok(None);
+        }
+        // The owner alternates with the edge index: even edges give the tab to the
+        // face of half-edge 2e, odd edges to the face of 2e + 1.
+        let owner = if e.0.is_multiple_of(2) {
+            e.half_edge()
+        } else {
+            e.half_edge().twin()
+        };
+        Ok(make_tab(mesh, owner, options))
+    });
+    let Ok(mut tabs) = made;
+    tabs.slot.shrink_to_fit();
     tabs.tabs.shrink_to_fit();
 
     let connections = tabs.tabs.len();
