@@ -113,6 +113,10 @@ fn the_thesis_bunny_builds_end_to_end() {
         // Even panels (the default regular mode): their outlines grown by half the
         // spacing fit in 10 usable sheets (9.88); the accurate mode's need 10.18.
         assert_eq!(count(&m, "counts.sheets_spacing_bound"), 10);
+        // Rows of interlocking panels: 12 sheets, the thesis' count (first-fit
+        // construction gave 13). The issue asks for 11.
+        let sheets = count(&m, "counts.sheets");
+        assert!(sheets <= 12, "{sheets} sheets");
         assert!(
             report.stderr.contains("simplified from 69451 faces"),
             "{}",

@@ -3,12 +3,17 @@
 //!
 //! Collision detection is jagua-rs (every part inflated by half the spacing, the sheet
 //! grown by the same amount); the search is ours:
-//! 1. constructive: parts largest first, each into the first sheet where a sampled,
-//!    then slid, bottom-left position is free (first-fit decreasing on true shapes),
-//!    poses that touch their neighbours scoring better ([`CONTACT_WEIGHT`]);
-//! 2. improvement: the emptiest sheet is emptied into the others, part by part, with a
-//!    wider search; a sheet left empty is dropped. Partial moves are kept: they only
-//!    make the emptiest sheet emptier (the second objective);
+//! 1. constructive, twice, side by side: in rows ([`rows`]: parts lie flat, tallest
+//!    first, each dropped at the end of the current row and slid down and left until
+//!    it rests, the next part chosen among the next few by how little of the row it
+//!    claims, so slanted ends interlock), and first-fit decreasing (parts largest
+//!    first, each into the first sheet where a sampled, then slid, bottom-left
+//!    position is free, poses that touch their neighbours scoring better
+//!    ([`CONTACT_WEIGHT`]));
+//! 2. improvement, of each construction: the emptiest sheet is emptied into the
+//!    others, part by part, by the same search; a sheet left empty is dropped.
+//!    Partial moves are kept: they only make the emptiest sheet emptier (the second
+//!    objective). The better of the two layouts goes on;
 //! 3. squeezing by overlap minimisation ([`separate`]): the emptiest sheet's parts,
 //!    largest first, go one at a time to where they overlap least on one of the
 //!    emptiest other sheets, which is then separated by a guided local search; a part
@@ -38,6 +43,7 @@ use jagua_rs::geometry::shape_modification::{ShapeModifyConfig, ShapeModifyMode}
 use jagua_rs::geometry::{AllowedOrientations, DTransformation, OriginalShape};
 use rayon::prelude::*;
 
+mod rows;
 mod separate;
 
 use super::grid::Grid;
@@ -79,7 +85,8 @@ const LEFT_WEIGHT: f32 = 0.5;
 /// sheet's edge, per part size (square root of its area) at full contact. Bottom-left
 /// alone leaves a part wherever its top is lowest, often in a corner that leaves a
 /// gap no other part fills; preferring poses that hug their neighbours packs tighter.
-/// Measured at weight 1 against 0 (default effort): the knight half-edge 14 → 13
+/// Measured at weight 1 against 0 (default effort), when the construction was a
+/// first-fit decreasing by this search (before [`rows`]): the knight half-edge 14 → 13
 /// sheets; spot half-edge's last sheet 26 % → 9 % full and fertility's 29 % → 21 %,
 /// same counts; the bunny, suzanne, horse_quad (half-, quad-, winged-edge, woven) and
 /// spot quad-edge same counts. Weights 0.5 and 2 did no better.
@@ -147,7 +154,8 @@ struct Candidate {
     y: f32,
 }
 
-/// How many of the best samples get the local search. Measured with the contact bonus
+/// How many of the best samples get the local search. Measured (with the first-fit
+/// construction, before [`rows`]) with the contact bonus
 /// (seeds 0 and 1), 6 with a left weight of 0.5 against 3 with 0.2: spot half-edge 26
 /// → 25 sheets (nest 6.2 → 8.8 s), suzanne 17 → 16 at seed 0, the knight and the bunny
 /// the same counts with emptier last sheets (bunny 53 % → 37 %, 59 % → 34 %); 8 gave
@@ -205,38 +213,34 @@ pub fn true_shape_layout(
     options: &NestOptions,
 ) -> Result<Layout, TooLarge> {
     let (parts, container) = prepare(outlines, sheet, options)?;
-    let mut nester = Nester::new(&parts, container, options);
-
-    // Largest first; ties by index so the order is total.
-    let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
-    for &p in &order {
-        if !nester.place_anywhere(p) {
-            return Err(too_large(p, &outlines[p], sheet, options.rotations));
-        }
-    }
-
-    // The improvement may spend effort/2 times the collision checks of the
-    // construction: bounded work, whatever the machine.
-    nester.started = Instant::now();
-    nester.budget = nester.checks + nester.checks * u64::from(options.effort.max(1)) / 2;
-    let effort = options.effort.max(1) as usize;
-    let mut stalled = 0;
-    for _ in 0..40 * effort {
-        if nester.sheets.len() < 2 || nester.out_of_budget() {
-            break;
-        }
-        // Move what fits out of the emptiest sheet; when nothing does, make room for
-        // its largest part on another sheet by ejecting the parts in one window there.
-        if nester.empty_emptiest_sheet() || nester.eject_and_insert() {
-            stalled = 0;
+    // Two constructions, each improved on its own, and the better kept: rows of
+    // interlocking parts win on alike parts (the bunny 13 → 12 sheets, spot and
+    // fertility quad-edge 14 → 13), first-fit decreasing on wavy strips (the woven
+    // torus-8x6 1 sheet against 2). Each has its own generator from the same seed,
+    // so the result does not depend on which finishes first.
+    let built = |in_rows: bool| -> Result<Nester, usize> {
+        let mut nester = Nester::new(&parts, container.clone(), options);
+        if in_rows {
+            nester.construct_in_rows()?;
         } else {
-            stalled += 1;
-            if stalled >= 4 * effort {
-                break;
-            }
+            nester.construct_first_fit()?;
         }
-    }
+        nester.improve(options);
+        Ok(nester)
+    };
+    let (first_fit, rows) = rayon::join(|| built(false), || built(true));
+    let too_large_part = |p: usize| too_large(p, &outlines[p], sheet, options.rotations);
+    let (first_fit, rows) = (
+        first_fit.map_err(too_large_part)?,
+        rows.map_err(too_large_part)?,
+    );
+    let mut nester = if rows.better_than(&first_fit) {
+        rows
+    } else {
+        first_fit
+    };
+    let effort = options.effort.max(1) as usize;
+
     // Then squeeze the emptiest sheet's parts into the others by overlap
     // minimisation, with an allowance of its own: unlike the improvement's, it does
     // not grow with the number of parts, because the squeeze only ever moves one
@@ -567,6 +571,58 @@ impl<'a> Nester<'a> {
         (self.samples as f64 * (1.0 + 3.0 * ratio)) as usize
     }
 
+    /// First-fit decreasing: parts largest first (ties by index), each into the first
+    /// open sheet where the pose search finds room, or onto a new sheet. `Err(part)`
+    /// names a part that fits no empty sheet.
+    fn construct_first_fit(&mut self) -> Result<(), usize> {
+        let parts = self.parts;
+        let mut order: Vec<usize> = (0..parts.len()).collect();
+        order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
+        for p in order {
+            if !self.place_anywhere(p) {
+                return Err(p);
+            }
+        }
+        Ok(())
+    }
+
+    /// Empties the emptiest sheet into the others while moves succeed, within
+    /// `effort / 2` times the collision checks of the construction: bounded work,
+    /// whatever the machine.
+    fn improve(&mut self, options: &NestOptions) {
+        self.started = Instant::now();
+        self.budget = self.checks + self.checks * u64::from(options.effort.max(1)) / 2;
+        let effort = options.effort.max(1) as usize;
+        let mut stalled = 0;
+        for _ in 0..40 * effort {
+            if self.sheets.len() < 2 || self.out_of_budget() {
+                break;
+            }
+            // Move what fits out of the emptiest sheet; when nothing does, make room
+            // for its largest part on another sheet by ejecting the parts in one
+            // window there.
+            if self.empty_emptiest_sheet() || self.eject_and_insert() {
+                stalled = 0;
+            } else {
+                stalled += 1;
+                if stalled >= 4 * effort {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Fewer sheets, or as many with an emptier emptiest sheet (the objective).
+    fn better_than(&self, other: &Nester) -> bool {
+        let least = |n: &Nester| {
+            n.sheets
+                .iter()
+                .map(|s| s.area)
+                .fold(f64::INFINITY, f64::min)
+        };
+        (self.sheets.len(), least(self)) < (other.sheets.len(), least(other))
+    }
+
     fn put(&mut self, s: usize, part: usize, c: Candidate) {
         let pose = self.pose(part, c);
         let sheet = &mut self.sheets[s];
@@ -888,20 +944,25 @@ impl<'a> Nester<'a> {
         c: Candidate,
         scratch: &mut SPolygon,
     ) -> Option<f32> {
-        let item = &self.parts[part].item;
-        let cde = self.sheets[s].layout.cde();
-        let transform = self.pose(part, c).compose();
-        let shape = item.shape_cd();
-        if cde.detect_surrogate_collision(shape.surrogate(), &transform, &NoFilter) {
-            return None;
-        }
-        scratch.transform_from(shape, &transform);
-        if cde.detect_poly_collision(scratch, &NoFilter) {
+        if !self.is_free(s, part, c, scratch) {
             return None;
         }
         let bb = scratch.bbox();
         let contact = contact_share(&self.sheets[s].grid, scratch);
         Some(bb.y_max + LEFT_WEIGHT * bb.x_max - CONTACT_WEIGHT * contact * scratch.area().sqrt())
+    }
+
+    /// Whether a pose collides with nothing on sheet `s`; `scratch` (from
+    /// [`Self::scratch_for`] of the same part) holds the posed shape when it is free.
+    fn is_free(&self, s: usize, part: usize, c: Candidate, scratch: &mut SPolygon) -> bool {
+        let cde = self.sheets[s].layout.cde();
+        let transform = self.pose(part, c).compose();
+        let shape = self.parts[part].item.shape_cd();
+        if cde.detect_surrogate_collision(shape.surrogate(), &transform, &NoFilter) {
+            return false;
+        }
+        scratch.transform_from(shape, &transform);
+        !cde.detect_poly_collision(scratch, &NoFilter)
     }
 
     /// Placements in part order; sheets fullest first (ties by the order they opened).

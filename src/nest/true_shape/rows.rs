@@ -1,0 +1,246 @@
+//! Construction in rows: parts lie flat (their long side along the sheet's width),
+//! tallest first, and each is dropped from the top of the sheet at the end of the
+//! current row and slid left and down until it rests (the bottom-left "gravity" of
+//! Jakobs' BL, on true shapes). At each step the part to place is chosen among the
+//! next few in height order by how little of the row it claims per unit of its own
+//! area, so slanted ends interlock (a trapezoid turned half a turn fills its
+//! neighbour's slant) and parts of one height share a row.
+
+use jagua_rs::geometry::primitives::SPolygon;
+use rayon::prelude::*;
+
+use super::{Candidate, Nester, Part, EDGE_GAP, MIN_STEP};
+
+/// Parts, next in height order, that compete for each place in a row.
+const ROW_CANDIDATES: usize = 12;
+
+/// Parts, next in height order among those narrow enough, tried at a row's end
+/// when none of the row candidates fits there.
+const ROW_END_CANDIDATES: usize = 48;
+
+/// Rounds of dropping and sliding left before a part is taken to rest.
+const SETTLE_ROUNDS: usize = 4;
+
+/// A part placed in a row: its pose, the right and top of its bounds, and the score.
+#[derive(Clone, Copy)]
+struct Rest {
+    pose: Candidate,
+    right: f32,
+    score: f32,
+}
+
+impl Nester<'_> {
+    /// Places every part in rows (see the module documentation), opening sheets as
+    /// needed. `Err(part)` names a part that fits no empty sheet.
+    pub(super) fn construct_in_rows(&mut self) -> Result<(), usize> {
+        let parts = self.parts;
+        let flat: Vec<Vec<usize>> = parts.iter().map(flat_orientations).collect();
+        let height = |p: usize| {
+            flat[p]
+                .iter()
+                .map(|&o| parts[p].orientations[o].hi.1 - parts[p].orientations[o].lo.1)
+                .fold(f32::INFINITY, f32::min)
+        };
+        let width = |p: usize| {
+            flat[p]
+                .iter()
+                .map(|&o| parts[p].orientations[o].hi.0 - parts[p].orientations[o].lo.0)
+                .fold(f32::INFINITY, f32::min)
+        };
+        let mut left: Vec<usize> = (0..parts.len()).collect();
+        left.sort_by(|&a, &b| {
+            height(b)
+                .total_cmp(&height(a))
+                .then(parts[b].area.total_cmp(&parts[a].area))
+                .then(a.cmp(&b))
+        });
+        let mut s = self.open_sheet();
+        let x_min = self.bounds.x_min;
+        let mut row_x = x_min;
+        let mut row_height = 0.0f32;
+        while !left.is_empty() {
+            let mut tried: Vec<usize> = (0..left.len().min(ROW_CANDIDATES)).collect();
+            let mut best = self.best_rest(s, &left, &tried, &flat, row_x, row_height);
+            if best.is_none() && row_x > x_min {
+                // The row's end: any narrower part that fits there.
+                let room = self.bounds.x_max - row_x;
+                tried = (0..left.len())
+                    .filter(|&i| width(left[i]) <= room)
+                    .take(ROW_END_CANDIDATES)
+                    .collect();
+                best = self.best_rest(s, &left, &tried, &flat, row_x, row_height);
+            }
+            match best {
+                Some((i, rest)) => {
+                    let part = left.remove(i);
+                    self.put(s, part, rest.pose);
+                    if row_height == 0.0 {
+                        row_height = height(part);
+                    }
+                    row_x = row_x.max(rest.right);
+                }
+                None if row_x > x_min => {
+                    row_x = x_min;
+                    row_height = 0.0;
+                }
+                None if self.sheets[s].parts.is_empty() => {
+                    // No flat pose fits an empty sheet: the tallest part may still
+                    // fit turned, which the sampled search also tries.
+                    let part = left[0];
+                    let pose = self.search(s, part, self.samples.max(64)).ok_or(part)?;
+                    self.put(s, part, pose);
+                    left.remove(0);
+                }
+                None => {
+                    s = self.open_sheet();
+                    row_height = 0.0;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The best resting pose among the parts `left[i]` for `i` in `tried`, each in
+    /// its flat orientations, started at the row's end `row_x` at the top of sheet
+    /// `s`: the index into `left` and the rest. Candidates are settled in parallel
+    /// and compared in order (the earlier wins ties).
+    fn best_rest(
+        &mut self,
+        s: usize,
+        left: &[usize],
+        tried: &[usize],
+        flat: &[Vec<usize>],
+        row_x: f32,
+        row_height: f32,
+    ) -> Option<(usize, Rest)> {
+        let tasks: Vec<(usize, usize)> = tried
+            .iter()
+            .flat_map(|&i| flat[left[i]].iter().map(move |&o| (i, o)))
+            .collect();
+        let this = &*self;
+        let rests: Vec<(Option<Rest>, u64)> = tasks
+            .par_iter()
+            .with_min_len(1)
+            .map(|&(i, o)| this.rest_in_row(s, left[i], o, row_x, row_height))
+            .collect();
+        let mut best: Option<(usize, Rest)> = None;
+        for (&(i, _), (rest, checks)) in tasks.iter().zip(rests) {
+            self.checks += checks;
+            if let Some(rest) = rest {
+                if best.is_none_or(|(_, b)| rest.score < b.score) {
+                    best = Some((i, rest));
+                }
+            }
+        }
+        best
+    }
+
+    /// Where `part` in orientation `o` comes to rest when dropped at the row's end,
+    /// and how much of the row it claims per unit of its area (lower is better), or
+    /// `None` when it does not fit there; with the checks made.
+    fn rest_in_row(
+        &self,
+        s: usize,
+        part: usize,
+        o: usize,
+        row_x: f32,
+        row_height: f32,
+    ) -> (Option<Rest>, u64) {
+        let p = &self.parts[part];
+        let or = p.orientations[o];
+        let mut scratch = self.scratch_for(part);
+        // A hair right of the row's end: a part touching its neighbour's bounds in f32
+        // counts as colliding, and could not drop past it.
+        let start = self.clamp(part, o, row_x + EDGE_GAP - or.lo.0, f32::INFINITY);
+        if start.x + or.lo.0 < row_x {
+            // Clamped back into the row: too wide for what is left of it.
+            return (None, 0);
+        }
+        let mut checks = 1;
+        if !self.is_free(s, part, start, &mut scratch) {
+            return (None, checks);
+        }
+        let mut c = start;
+        for _ in 0..SETTLE_ROUNDS {
+            let before = (c.x, c.y);
+            c = self.slide(s, part, c, (0.0, -1.0), &mut scratch, &mut checks);
+            c = self.slide(s, part, c, (-1.0, 0.0), &mut scratch, &mut checks);
+            if before == (c.x, c.y) {
+                break;
+            }
+        }
+        let right = c.x + or.hi.0;
+        let height = if row_height > 0.0 {
+            row_height.max(or.hi.1 - or.lo.1)
+        } else {
+            or.hi.1 - or.lo.1
+        };
+        let claimed = (right - row_x).max(0.0) * height;
+        let grown = p.item.shape_cd().area();
+        // Ties (parts resting in earlier gaps claim nothing) go to the lower pose.
+        let score = claimed / grown + 1e-6 * (c.y + or.hi.1);
+        (
+            Some(Rest {
+                pose: c,
+                right,
+                score,
+            }),
+            checks,
+        )
+    }
+
+    /// Moves a free pose in direction `dir` as far as it stays free: steps halve from
+    /// half the sheet's size down to [`MIN_STEP`].
+    fn slide(
+        &self,
+        s: usize,
+        part: usize,
+        mut c: Candidate,
+        dir: (f32, f32),
+        scratch: &mut SPolygon,
+        checks: &mut u64,
+    ) -> Candidate {
+        let b = self.bounds;
+        let mut step = 0.5 * (b.x_max - b.x_min).max(b.y_max - b.y_min);
+        while step > MIN_STEP {
+            let next = self.clamp(part, c.orientation, c.x + dir.0 * step, c.y + dir.1 * step);
+            if (next.x, next.y) == (c.x, c.y) {
+                step *= 0.5;
+                continue;
+            }
+            *checks += 1;
+            if self.is_free(s, part, next, scratch) {
+                c = next;
+            } else {
+                step *= 0.5;
+            }
+        }
+        c
+    }
+}
+
+/// The orientations of a part that lie square to its axis with its long side along
+/// the sheet's width; all square ones for a part about as tall as wide, all of them
+/// when none is square.
+fn flat_orientations(p: &Part) -> Vec<usize> {
+    let size = |o: usize| {
+        let or = p.orientations[o];
+        (or.hi.0 - or.lo.0, or.hi.1 - or.lo.1)
+    };
+    let flat: Vec<usize> = p
+        .square
+        .iter()
+        .copied()
+        .filter(|&o| {
+            let (w, h) = size(o);
+            w >= 0.9 * h
+        })
+        .collect();
+    if !flat.is_empty() {
+        flat
+    } else if !p.square.is_empty() {
+        p.square.clone()
+    } else {
+        (0..p.orientations.len()).collect()
+    }
+}
