@@ -54,6 +54,9 @@ impl Nester<'_> {
                 .then(parts[b].area.total_cmp(&parts[a].area))
                 .then(a.cmp(&b))
         });
+        if left.is_empty() {
+            return Ok(());
+        }
         let mut s = self.open_sheet();
         let x_min = self.bounds.x_min;
         let mut row_x = x_min;
