@@ -11,7 +11,7 @@
 //!    position is free, poses that touch their neighbours scoring better
 //!    ([`CONTACT_WEIGHT`]));
 //! 2. improvement, of each construction: the emptiest sheet is emptied into the
-//!    others, part by part, by the same search; a sheet left empty is dropped.
+//!    others, part by part, by the sampled pose search; a sheet left empty is dropped.
 //!    Partial moves are kept: they only make the emptiest sheet emptier (the second
 //!    objective). The better of the two layouts goes on;
 //! 3. squeezing by overlap minimisation ([`separate`]): the emptiest sheet's parts,
@@ -20,7 +20,8 @@
 //!    stays only when that succeeds, and the squeeze stops at the first part that
 //!    finds no room. A sheet left empty is dropped.
 //!
-//! Every random choice comes from one generator seeded by `seed`, and the effort is a
+//! Every random choice comes from a generator seeded by `seed` (one per construction
+//! and what follows it), and the effort is a
 //! number of samples and rounds, so the result depends on the input and the options
 //! only. The sampled poses of a search are drawn in order and then tested in
 //! parallel against a sheet that does not change meanwhile, and compared in order,
@@ -201,7 +202,8 @@ struct Nester<'a> {
     overlap: separate::OverlapScratch,
     /// Collision checks the current phase may reach.
     budget: u64,
-    /// When the improvement started, and how long it may run.
+    /// When the improvements started (both constructions' share one start), and how
+    /// long they and the squeeze may run together.
     started: Instant,
     time_limit: Duration,
 }
@@ -218,6 +220,10 @@ pub fn true_shape_layout(
     // fertility quad-edge 14 → 13), first-fit decreasing on wavy strips (the woven
     // torus-8x6 1 sheet against 2). Each has its own generator from the same seed,
     // so the result does not depend on which finishes first.
+    // One clock, started before the constructions (which always finish), for both
+    // improvements and the squeeze: `time_limit` caps them together, on one thread
+    // (where the two improvements run one after the other) as on two.
+    let started = Instant::now();
     let built = |in_rows: bool| -> Result<Nester, usize> {
         let mut nester = Nester::new(&parts, container.clone(), options);
         if in_rows {
@@ -225,7 +231,7 @@ pub fn true_shape_layout(
         } else {
             nester.construct_first_fit()?;
         }
-        nester.improve(options);
+        nester.improve(options, started);
         Ok(nester)
     };
     let (first_fit, rows) = rayon::join(|| built(false), || built(true));
@@ -589,8 +595,8 @@ impl<'a> Nester<'a> {
     /// Empties the emptiest sheet into the others while moves succeed, within
     /// `effort / 2` times the collision checks of the construction: bounded work,
     /// whatever the machine.
-    fn improve(&mut self, options: &NestOptions) {
-        self.started = Instant::now();
+    fn improve(&mut self, options: &NestOptions, started: Instant) {
+        self.started = started;
         self.budget = self.checks + self.checks * u64::from(options.effort.max(1)) / 2;
         let effort = options.effort.max(1) as usize;
         let mut stalled = 0;
