@@ -216,10 +216,11 @@ pub fn true_shape_layout(
 ) -> Result<Layout, TooLarge> {
     let (parts, container) = prepare(outlines, sheet, options)?;
     // Two constructions, each improved on its own, and the better kept: rows of
-    // interlocking parts win on alike parts (the bunny 13 → 12 sheets, spot and
-    // fertility quad-edge 14 → 13), first-fit decreasing on wavy strips (the woven
-    // torus-8x6 1 sheet against 2). Each has its own generator from the same seed,
-    // so the result does not depend on which finishes first.
+    // interlocking parts win on alike parts and long strips, first-fit decreasing on
+    // short wavy strips (README, "Nesting", has the measured cases). Each has its own
+    // generator from the same seed, so the result does not depend on which finishes
+    // first.
+    //
     // One clock, started before the constructions (which always finish), for both
     // improvements and the squeeze: `time_limit` caps them together, on one thread
     // (where the two improvements run one after the other) as on two.
@@ -593,8 +594,8 @@ impl<'a> Nester<'a> {
     }
 
     /// Empties the emptiest sheet into the others while moves succeed, within
-    /// `effort / 2` times the collision checks of the construction: bounded work,
-    /// whatever the machine.
+    /// `effort / 2` times the collision checks of the construction (bounded work,
+    /// whatever the machine) and the time limit counted from `started`.
     fn improve(&mut self, options: &NestOptions, started: Instant) {
         self.started = started;
         self.budget = self.checks + self.checks * u64::from(options.effort.max(1)) / 2;

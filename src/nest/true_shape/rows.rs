@@ -1,17 +1,19 @@
 //! Construction in rows: parts lie flat (their long side along the sheet's width),
 //! tallest first, and each is dropped from the top of the sheet at the end of the
 //! current row and slid down and left until it rests (the bottom-left "gravity" of
-//! Jakobs' BL, on true shapes). A part wider than what is left of the row's bounds
-//! starts at the sheet's right edge on the row's floor and slides left first, so the
-//! last part of a row can reach under its neighbour's slanted end. The slides test
-//! where each step ends, halving the step on a collision: a long step may pass a part
-//! into free space beyond it, so "rests" means no step of at least 0.05 mm down or
-//! left is free, not that the part touches whatever it passed. At each step the part to place is chosen among the
+//! Jakobs' BL, on true shapes). At each step the part to place is chosen among the
 //! next few in height order by how little of the row it claims per unit of its own
 //! area, so slanted ends interlock (a trapezoid turned half a turn fills its
 //! neighbour's slant) and parts of one height share a row.
+//!
+//! A part wider than what is left of the row's bounds starts at the sheet's right
+//! edge on the row's floor and slides left first, so the last part of a row can
+//! reach under its neighbour's slanted end. The slides test where each step ends,
+//! halving the step on a collision: a long step may pass a part into free space
+//! beyond it, so "rests" means that no step of at least [`MIN_STEP`] down or left is
+//! free, not that the part touches whatever it passed.
 
-use jagua_rs::geometry::primitives::SPolygon;
+use jagua_rs::geometry::primitives::{Point, SPolygon};
 use rayon::prelude::*;
 
 use super::{Candidate, Nester, Part, EDGE_GAP, MIN_STEP};
@@ -52,18 +54,15 @@ impl Nester<'_> {
     pub(super) fn construct_in_rows(&mut self) -> Result<(), usize> {
         let parts = self.parts;
         let flat: Vec<Vec<usize>> = parts.iter().map(flat_orientations).collect();
-        let height = |p: usize| {
+        // The least width and height of a part's bounds over its flat orientations.
+        let extent = |p: usize, axis: fn(Point) -> f32| {
             flat[p]
                 .iter()
-                .map(|&o| parts[p].orientations[o].hi.1 - parts[p].orientations[o].lo.1)
+                .map(|&o| axis(parts[p].orientations[o].hi) - axis(parts[p].orientations[o].lo))
                 .fold(f32::INFINITY, f32::min)
         };
-        let width = |p: usize| {
-            flat[p]
-                .iter()
-                .map(|&o| parts[p].orientations[o].hi.0 - parts[p].orientations[o].lo.0)
-                .fold(f32::INFINITY, f32::min)
-        };
+        let height = |p: usize| extent(p, |q| q.1);
+        let width = |p: usize| extent(p, |q| q.0);
         let mut left: Vec<usize> = (0..parts.len()).collect();
         left.sort_by(|&a, &b| {
             height(b)
@@ -123,10 +122,10 @@ impl Nester<'_> {
         Ok(())
     }
 
-    /// The best resting pose among the parts `left[i]` for `i` in `tried`, each in
-    /// its flat orientations, started at the row's end `row_x` at the top of sheet
-    /// `s`: the index into `left` and the rest. Candidates are settled in parallel
-    /// and compared in order (the earlier wins ties).
+    /// The best resting pose on sheet `s` at the end of `row` among the parts
+    /// `left[i]` for `i` in `tried`, each in its flat orientations (see
+    /// [`Nester::rest_in_row`]): the index into `left` and the rest. Candidates are
+    /// settled in parallel and compared in order (the earlier wins ties).
     fn best_rest(
         &mut self,
         s: usize,
@@ -157,9 +156,11 @@ impl Nester<'_> {
         best
     }
 
-    /// Where `part` in orientation `o` comes to rest when dropped at the row's end,
-    /// and how much of the row it claims per unit of its area (lower is better), or
-    /// `None` when it does not fit there; with the checks made.
+    /// Where `part` in orientation `o` comes to rest when dropped at the row's end
+    /// (or, wider than what is left of the row's bounds, slid in from the sheet's
+    /// right edge on the row's floor), and how much of the row it claims per unit of
+    /// its area (lower is better), or `None` when it does not fit there; with the
+    /// checks made.
     fn rest_in_row(&self, s: usize, part: usize, o: usize, row: Row) -> (Option<Rest>, u64) {
         let p = &self.parts[part];
         let or = p.orientations[o];
@@ -242,8 +243,9 @@ impl Nester<'_> {
 }
 
 /// The orientations of a part that lie square to its axis with its long side along
-/// the sheet's width; all square ones for a part about as tall as wide, all of them
-/// when none is square.
+/// the sheet's width (all four quarter turns for a part about as tall as wide); the
+/// quarter turns standing when none lying fits the sheet; every orientation when no
+/// quarter turn fits.
 fn flat_orientations(p: &Part) -> Vec<usize> {
     let size = |o: usize| {
         let or = p.orientations[o];
