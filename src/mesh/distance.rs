@@ -122,23 +122,52 @@ impl<'a> TriangleGrid<'a> {
 
     /// Distance from `p` to the nearest triangle (infinite when there is none).
     pub fn distance(&self, p: DVec3) -> f64 {
+        self.nearest(p)
+            .map_or(f64::INFINITY, |(_, q)| q.distance(p))
+    }
+
+    /// The nearest triangle to `p` (the lowest index among equally near ones seen
+    /// first) and its closest point, or `None` when there is no triangle.
+    pub fn nearest(&self, p: DVec3) -> Option<(usize, DVec3)> {
         if self.triangles.is_empty() {
-            return f64::INFINITY;
+            return None;
         }
         let home = [0, 1, 2].map(|k| cell_index(p, k, self.lo, self.cell, self.dims));
-        let mut best = f64::INFINITY;
+        let mut best: Option<(usize, DVec3, f64)> = None;
         let max_ring = self.dims.iter().copied().max().unwrap_or(1);
         for ring in 0..=max_ring {
-            // Every cell not yet visited is at least (ring - 1) cells away.
-            if ring > 0 && best <= (ring as f64 - 1.0) * self.cell {
+            // Every cell not yet visited lies outside the box of the rings visited, at
+            // least as far from `p` as that box's nearest side.
+            if ring > 0 && best.is_some_and(|b| b.2 <= self.inside_distance(p, home, ring - 1)) {
                 break;
             }
             self.visit_ring(home, ring, |t| {
                 let [a, b, c] = self.triangles[t];
-                best = best.min(closest_point_on_triangle(p, a, b, c).distance(p));
+                let q = closest_point_on_triangle(p, a, b, c);
+                let d = q.distance(p);
+                let closer = match best {
+                    None => true,
+                    Some((bt, _, bd)) => d < bd || (d == bd && t < bt),
+                };
+                if closer {
+                    best = Some((t, q, d));
+                }
             });
         }
-        best
+        best.map(|(t, q, _)| (t, q))
+    }
+
+    /// How far `p` lies inside the box of the cells within Chebyshev distance `ring`
+    /// of `home` (0 when outside it).
+    fn inside_distance(&self, p: DVec3, home: [usize; 3], ring: usize) -> f64 {
+        (0..3)
+            .map(|k| {
+                let lo = self.lo[k] + (home[k] as f64 - ring as f64) * self.cell;
+                let hi = self.lo[k] + (home[k] + ring + 1) as f64 * self.cell;
+                (p[k] - lo).min(hi - p[k])
+            })
+            .fold(f64::INFINITY, f64::min)
+            .max(0.0)
     }
 
     /// Calls `f` with every triangle of the cells at Chebyshev distance `ring` from

@@ -15,6 +15,7 @@ pub mod planarize;
 pub mod polygons;
 pub mod prepare;
 pub mod read;
+pub mod relax;
 pub mod simplify;
 pub mod soup;
 pub mod split;

@@ -55,9 +55,15 @@ pub struct SimplifyReport {
     /// The largest distance (model units) from the original surface to the simplified
     /// one, measured at every original vertex and triangle centre.
     pub deviation: f64,
+    /// The mean of those distances (model units).
+    pub mean_deviation: f64,
+    /// Vertex moves kept by the relaxation of regular mode (0 in accurate mode).
+    pub relaxed_moves: usize,
     /// The longest edge over the median edge after simplification: how far the
     /// largest panel is from a typical one.
     pub edge_spread: f64,
+    /// The 95th-percentile edge over the median edge: how alike most panels are.
+    pub edge_spread_95: f64,
     /// In regular mode, the simplification used instead when regularizing did not keep
     /// the topology or did not build (`None`: as asked).
     pub fallback: Option<&'static str>,
@@ -137,7 +143,10 @@ pub fn simplify(
                 before: (before.faces, before.edges),
                 after: (before.faces, before.edges),
                 deviation: 0.0,
-                edge_spread: edge_spread(mesh),
+                mean_deviation: 0.0,
+                relaxed_moves: 0,
+                edge_spread: edge_spread(mesh).0,
+                edge_spread_95: edge_spread(mesh).1,
                 fallback: None,
             },
         ));
@@ -150,6 +159,7 @@ pub fn simplify(
         locked: &locked,
         budget,
         target,
+        relax: mode == SimplifyMode::Regular,
     };
     // Regularizing collapses across thin handles more readily (fertility at 600
     // edges loses one of its four): when its result changes the topology or does not
@@ -190,6 +200,8 @@ struct Input<'a> {
     budget: Budget,
     /// First guess at the number of triangles.
     target: usize,
+    /// Relax the result toward even edges (regular mode).
+    relax: bool,
 }
 
 impl Input<'_> {
@@ -266,8 +278,12 @@ impl Input<'_> {
             );
         }
         let face_source: Vec<u32> = vec![u32::MAX; polys.face_count()];
-        let (simplified, _) = build_mesh(&polys, Some(&source), Some(&face_source))
-            .map_err(|e| SimplifyError::Invalid(e.to_string()))?;
+        let build = |polys: &Polygons| {
+            build_mesh(polys, Some(&source), Some(&face_source))
+                .map(|(m, _)| m)
+                .map_err(|e| SimplifyError::Invalid(e.to_string()))
+        };
+        let mut simplified = build(&polys)?;
         let after = simplified.topology();
         if after.genus != before.genus || after.boundary_loops != before.boundary_loops {
             return Err(SimplifyError::Topology {
@@ -278,34 +294,80 @@ impl Input<'_> {
                 loops_after: after.boundary_loops,
             });
         }
+        let samples = surface_samples(mesh.positions(), indices);
+        let mut relaxed_moves = 0;
+        if self.relax {
+            // Relaxing moves vertices only: the connectivity, and so the topology just
+            // checked, stay.
+            let original: Vec<[glam::DVec3; 3]> = indices
+                .chunks_exact(3)
+                .map(|t| [0, 1, 2].map(|k| mesh.positions()[t[k] as usize]))
+                .collect();
+            let grid = super::distance::TriangleGrid::new(&original);
+            let triangles: Vec<[u32; 3]> = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
+            let surface = super::relax::Surface {
+                grid: &grid,
+                samples: &samples,
+            };
+            relaxed_moves = super::relax::relax(&mut polys.positions, &triangles, &surface);
+            if relaxed_moves > 0 {
+                simplified = build(&polys)?;
+            }
+        }
+        let (deviation, mean_deviation) = deviation(&samples, &simplified);
+        let spread = edge_spread(&simplified);
         let report = SimplifyReport {
             before: (indices.len() / 3, edge_count(indices)),
             after: (after.faces, after.edges),
-            deviation: deviation(mesh.positions(), indices, &simplified),
-            edge_spread: edge_spread(&simplified),
+            deviation,
+            mean_deviation,
+            relaxed_moves,
+            edge_spread: spread.0,
+            edge_spread_95: spread.1,
             fallback: None,
         };
         Ok((simplified, report))
     }
 }
 
-/// The longest edge length over the median one.
-fn edge_spread(mesh: &Mesh) -> f64 {
+/// The longest edge length and the 95th-percentile one, each over the median.
+fn edge_spread(mesh: &Mesh) -> (f64, f64) {
     let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
     lengths.sort_unstable_by(f64::total_cmp);
-    let median = lengths.get(lengths.len() / 2).copied().unwrap_or(0.0);
-    let longest = lengths.last().copied().unwrap_or(0.0);
+    let at = |share: f64| {
+        let k = ((lengths.len() as f64 - 1.0) * share).round() as usize;
+        lengths.get(k).copied().unwrap_or(0.0)
+    };
+    let median = at(0.5);
     if median > 0.0 {
-        longest / median
+        (at(1.0) / median, at(0.95) / median)
     } else {
-        0.0
+        (0.0, 0.0)
     }
 }
 
-/// The largest distance from the original surface (`positions` and its triangles
-/// `indices`) to the simplified triangle mesh, at every original vertex and triangle
-/// centre. In parallel; the maximum does not depend on the order.
-fn deviation(positions: &[glam::DVec3], indices: &[u32], simplified: &Mesh) -> f64 {
+/// Where closeness to the original surface (`positions` and its triangles `indices`)
+/// is measured: every vertex the triangles use, then every triangle centre.
+fn surface_samples(positions: &[glam::DVec3], indices: &[u32]) -> Vec<glam::DVec3> {
+    let mut used = vec![false; positions.len()];
+    for &v in indices {
+        used[v as usize] = true;
+    }
+    let corners = positions
+        .iter()
+        .zip(&used)
+        .filter(|(_, &u)| u)
+        .map(|(&p, _)| p);
+    let centres = indices.chunks_exact(3).map(|t| {
+        (positions[t[0] as usize] + positions[t[1] as usize] + positions[t[2] as usize]) / 3.0
+    });
+    corners.chain(centres).collect()
+}
+
+/// The largest and the mean distance from the `samples` of the original surface to
+/// the simplified triangle mesh. In parallel; the results do not depend on the order
+/// (the sum is taken in sample order).
+fn deviation(samples: &[glam::DVec3], simplified: &Mesh) -> (f64, f64) {
     use rayon::prelude::*;
     let triangles: Vec<[glam::DVec3; 3]> = simplified
         .faces()
@@ -316,25 +378,10 @@ fn deviation(positions: &[glam::DVec3], indices: &[u32], simplified: &Mesh) -> f
         })
         .collect();
     let grid = super::distance::TriangleGrid::new(&triangles);
-    let centres = indices.par_chunks_exact(3).map(|t| {
-        (positions[t[0] as usize] + positions[t[1] as usize] + positions[t[2] as usize]) / 3.0
-    });
-    let used: Vec<bool> = {
-        let mut used = vec![false; positions.len()];
-        for &v in indices {
-            used[v as usize] = true;
-        }
-        used
-    };
-    let corners = positions
-        .par_iter()
-        .zip(used.par_iter())
-        .filter(|(_, &u)| u)
-        .map(|(&p, _)| p);
-    corners
-        .chain(centres)
-        .map(|p| grid.distance(p))
-        .reduce(|| 0.0, f64::max)
+    let distances: Vec<f64> = samples.par_iter().map(|&p| grid.distance(p)).collect();
+    let largest = distances.iter().copied().fold(0.0, f64::max);
+    let mean = distances.iter().sum::<f64>() / distances.len().max(1) as f64;
+    (largest, mean)
 }
 
 /// Triangles of `indices` without degenerate ones and without pairs that use the same
