@@ -73,7 +73,7 @@ pub fn load_model(
                 report.before.0, report.before.1, report.after.0, report.after.1, mode,
                 report.edge_spread, report.edge_spread_95,
                 if report.relaxed_moves > 0 {
-                    format!("; vertices relaxed toward even edges in {} moves, keeping the largest and mean deviation", report.relaxed_moves)
+                    format!("; vertices relaxed toward even edges in {} moves, without increasing the largest or mean deviation", report.relaxed_moves)
                 } else {
                     String::new()
                 },

@@ -110,8 +110,8 @@ fn the_thesis_bunny_builds_end_to_end() {
         assert_eq!(count(&m, "counts.panels"), edges);
         assert_eq!(count(&m, "input.boundary_loops"), 5);
         assert_eq!(count(&m, "input.genus"), 0);
-        // Even panels (the default regular mode): their outlines grown by half the
-        // spacing fit in 10 usable sheets (9.88); the accurate mode's need 10.18.
+        // Even panels (the default regular mode, relaxed): their outlines grown by half
+        // the spacing fit in 10 usable sheets; the accurate mode's need 10.18.
         assert_eq!(count(&m, "counts.sheets_spacing_bound"), 10);
         // Rows of interlocking panels: 12 sheets, the thesis' count (first-fit
         // construction gave 13). The issue asks for 11.

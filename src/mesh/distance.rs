@@ -126,8 +126,8 @@ impl<'a> TriangleGrid<'a> {
             .map_or(f64::INFINITY, |(_, q)| q.distance(p))
     }
 
-    /// The nearest triangle to `p` (the lowest index among equally near ones seen
-    /// first) and its closest point, or `None` when there is no triangle.
+    /// The nearest triangle to `p` and its closest point (among equally near ones, the
+    /// lowest index of those the search visited), or `None` when there is no triangle.
     pub fn nearest(&self, p: DVec3) -> Option<(usize, DVec3)> {
         if self.triangles.is_empty() {
             return None;
@@ -137,8 +137,13 @@ impl<'a> TriangleGrid<'a> {
         let max_ring = self.dims.iter().copied().max().unwrap_or(1);
         for ring in 0..=max_ring {
             // Every cell not yet visited lies outside the box of the rings visited, at
-            // least as far from `p` as that box's nearest side.
-            if ring > 0 && best.is_some_and(|b| b.2 <= self.inside_distance(p, home, ring - 1)) {
+            // least as far from `p` as that box's nearest side (less a hair: a cell's
+            // index and its sides are rounded separately).
+            if ring > 0
+                && best.is_some_and(|b| {
+                    b.2 <= self.inside_distance(p, home, ring - 1) - 1e-9 * self.cell
+                })
+            {
                 break;
             }
             self.visit_ring(home, ring, |t| {

@@ -3,7 +3,8 @@
 //! halfway toward the centroid of its neighbours within its tangent plane, then onto
 //! the nearest point of the original surface (border vertices stay, so holes keep
 //! their rims). A move is kept only when every face around the vertex keeps its
-//! orientation (and a tenth of its area), and when the original surface stays as
+//! orientation and a tenth of its area (against the face before relaxing, so that no
+//! series of moves turns a face over), and when the original surface stays as
 //! close as simplification left it:
 //! - no sample of the original surface (its vertices and triangle centres, as the
 //!   deviation is measured) lies farther from the mesh than the largest deviation
@@ -46,11 +47,26 @@ pub struct Surface<'a> {
 }
 
 /// Relaxes the vertices `positions` of the triangles `triangles` (consistently
-/// oriented, manifold) toward `surface` (see the module documentation). Returns the
-/// number of moves kept. Deterministic: vertices move one at a time in index order.
-pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface) -> usize {
+/// oriented, manifold) toward `surface` (see the module documentation). Deterministic:
+/// vertices move one at a time in index order.
+pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface) -> Relaxed {
+    let mut relaxed = Relaxed {
+        moves: 0,
+        largest: 0.0,
+        sum: 0.0,
+    };
+    if triangles.is_empty() {
+        return relaxed;
+    }
     let rings = Rings::new(positions.len(), triangles);
-    let mut moves = 0;
+    // Every face's area vector before relaxing: a face may never turn more than a
+    // quarter turn from it, nor shrink below a tenth of it, however many moves it
+    // takes part in.
+    let area = |[a, b, c]: [DVec3; 3]| (b - a).cross(c - a);
+    let initial_area: Vec<DVec3> = triangles
+        .iter()
+        .map(|t| area(t.map(|v| positions[v as usize])))
+        .collect();
     // The largest and summed deviation that no round may exceed.
     let mut bounds: Option<(f64, f64)> = None;
     // Each sample's nearest face and its distance to it: over the whole mesh at
@@ -67,12 +83,12 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
             .samples
             .par_iter()
             .map(|&p| {
-                grid.nearest(p)
-                    .map_or((usize::MAX, 0.0), |(f, q)| (f, q.distance(p)))
+                let (f, q) = grid.nearest(p).expect("the mesh has triangles");
+                (f, q.distance(p))
             })
             .collect()
     };
-    let around = rings.faces_around_faces(triangles);
+    let around = rings.faces_around_faces();
     for round in 0..ROUNDS {
         if round > 0 {
             let fixed: &[DVec3] = positions;
@@ -81,9 +97,6 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
                 .par_iter()
                 .zip(&nearest)
                 .map(|(&p, &(f, _))| {
-                    if f == usize::MAX {
-                        return (f, 0.0);
-                    }
                     around[f]
                         .iter()
                         .map(|&g| {
@@ -99,6 +112,7 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
         let mut total: f64 = tracked.iter().sum();
         let (limit, budget) =
             *bounds.get_or_insert((tracked.iter().copied().fold(0.0, f64::max), total));
+        (relaxed.largest, relaxed.sum) = (limit, budget);
         let samples_of = samples_per_face(triangles.len(), &nearest);
 
         let mut moved_this_round = 0;
@@ -125,8 +139,7 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
                 })
             };
             let keeps_orientation = ring.iter().all(|&f| {
-                let area = |[a, b, c]: [DVec3; 3]| (b - a).cross(c - a);
-                let (before, after) = (area(posed(f, old)), area(posed(f, onto)));
+                let (before, after) = (initial_area[f], area(posed(f, onto)));
                 after.dot(before) > 0.0 && after.length() >= KEPT_AREA * before.length()
             });
             if !keeps_orientation {
@@ -155,36 +168,73 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
             }
             moved_this_round += 1;
         }
-        moves += moved_this_round;
+        relaxed.moves += moved_this_round;
         if moved_this_round == 0 {
             break;
         }
     }
-    moves
+    relaxed
+}
+
+/// What [`relax`] did, and the bounds it kept: the largest distance and the sum of the
+/// distances from the samples to the mesh before relaxing (as the samples' nearest
+/// faces gave them; the caller checks the relaxed mesh against them).
+#[derive(Clone, Copy, Debug)]
+pub struct Relaxed {
+    pub moves: usize,
+    pub largest: f64,
+    pub sum: f64,
+}
+
+/// Whether the faces `fan` around an interior vertex `v` form a single closed fan:
+/// following each face's edge opposite `v` from corner to corner visits them all.
+fn is_one_fan(v: u32, fan: &[usize], triangles: &[[u32; 3]]) -> bool {
+    // Each face, turned so that `v` comes first, gives the edge (next, after).
+    let spokes: Vec<(u32, u32)> = fan
+        .iter()
+        .map(|&f| {
+            let t = triangles[f];
+            let k = t
+                .iter()
+                .position(|&c| c == v)
+                .expect("a face of its corner");
+            (t[(k + 1) % 3], t[(k + 2) % 3])
+        })
+        .collect();
+    let Some(&(start, mut at)) = spokes.first() else {
+        return false;
+    };
+    let mut visited = 1;
+    while at != start && visited <= spokes.len() {
+        match spokes.iter().find(|s| s.0 == at) {
+            Some(&(_, next)) => at = next,
+            None => return false,
+        }
+        visited += 1;
+    }
+    at == start && visited == spokes.len()
 }
 
 /// The samples nearest to each face (indices into the samples), in sample order.
 fn samples_per_face(faces: usize, nearest: &[(usize, f64)]) -> Vec<Vec<usize>> {
     let mut out = vec![Vec::new(); faces];
     for (s, &(f, _)) in nearest.iter().enumerate() {
-        if f < faces {
-            out[f].push(s);
-        }
+        out[f].push(s);
     }
     out
 }
 
 /// What each vertex's move needs of the connectivity: its faces, its neighbours, and
 /// whether it may move at all (not on a border, not at a non-manifold edge).
-struct Rings {
-    triangles: Vec<[u32; 3]>,
+struct Rings<'a> {
+    triangles: &'a [[u32; 3]],
     faces: Vec<Vec<usize>>,
     neighbours: Vec<Vec<u32>>,
     movable: Vec<bool>,
 }
 
-impl Rings {
-    fn new(vertices: usize, triangles: &[[u32; 3]]) -> Self {
+impl<'a> Rings<'a> {
+    fn new(vertices: usize, triangles: &'a [[u32; 3]]) -> Self {
         let mut faces = vec![Vec::new(); vertices];
         let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * triangles.len());
         for (f, t) in triangles.iter().enumerate() {
@@ -208,8 +258,15 @@ impl Rings {
             neighbours[a as usize].push(b);
             neighbours[b as usize].push(a);
         }
+        // A vertex where several fans of faces meet at one point (the mesh builder
+        // splits it) has no one tangent plane: pinned too.
+        for (v, fan) in faces.iter().enumerate() {
+            if movable[v] && !is_one_fan(v as u32, fan, triangles) {
+                movable[v] = false;
+            }
+        }
         Rings {
-            triangles: triangles.to_vec(),
+            triangles,
             faces,
             neighbours,
             movable,
@@ -218,8 +275,8 @@ impl Rings {
 
     /// For every face, the faces that share an edge with it (itself included), in
     /// index order.
-    fn faces_around_faces(&self, triangles: &[[u32; 3]]) -> Vec<Vec<usize>> {
-        triangles
+    fn faces_around_faces(&self) -> Vec<Vec<usize>> {
+        self.triangles
             .iter()
             .enumerate()
             .map(|(f, t)| {
@@ -399,7 +456,7 @@ mod tests {
             grid: &grid,
             samples: &samples,
         };
-        let moves = relax(&mut relaxed, &faces, &surface);
+        let moves = relax(&mut relaxed, &faces, &surface).moves;
         let after = (
             deviation(&samples, &relaxed, &faces),
             spread(&relaxed, &faces),
