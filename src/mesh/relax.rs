@@ -332,49 +332,15 @@ impl<'a> Rings<'a> {
 mod tests {
     use super::*;
 
-    /// The icosahedron's corners (on the unit sphere) and faces, outward.
+    /// The project's icosahedron (`models/icosahedron.obj`, made by
+    /// `examples/gen_models.rs`), its corners moved onto the unit sphere.
     fn icosahedron() -> (Vec<DVec3>, Vec<[u32; 3]>) {
-        let t = (1.0 + 5f64.sqrt()) / 2.0;
-        let corners = [
-            (-1.0, t, 0.0),
-            (1.0, t, 0.0),
-            (-1.0, -t, 0.0),
-            (1.0, -t, 0.0),
-            (0.0, -1.0, t),
-            (0.0, 1.0, t),
-            (0.0, -1.0, -t),
-            (0.0, 1.0, -t),
-            (t, 0.0, -1.0),
-            (t, 0.0, 1.0),
-            (-t, 0.0, -1.0),
-            (-t, 0.0, 1.0),
-        ];
-        let faces = vec![
-            [0, 11, 5],
-            [0, 5, 1],
-            [0, 1, 7],
-            [0, 7, 10],
-            [0, 10, 11],
-            [1, 5, 9],
-            [5, 11, 4],
-            [11, 10, 2],
-            [10, 7, 6],
-            [7, 1, 8],
-            [3, 9, 4],
-            [3, 4, 2],
-            [3, 2, 6],
-            [3, 6, 8],
-            [3, 8, 9],
-            [4, 9, 5],
-            [2, 4, 11],
-            [6, 2, 10],
-            [8, 6, 7],
-            [9, 8, 1],
-        ];
-        let positions = corners
-            .iter()
-            .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-            .collect();
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("models/icosahedron.obj");
+        let polys = crate::mesh::read_model(&path)
+            .expect("the project's icosahedron")
+            .polys;
+        let positions = polys.positions.iter().map(|p| p.normalize()).collect();
+        let faces = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
         (positions, faces)
     }
 

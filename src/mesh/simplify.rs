@@ -10,6 +10,7 @@
 use super::build::build_mesh;
 use super::halfedge::Mesh;
 use super::polygons::Polygons;
+use super::relax::{relax, Surface};
 use super::topology::Topology;
 
 /// What to aim for.
@@ -155,16 +156,19 @@ pub fn simplify(
             },
         ));
     }
-    // The original surface, built once for every attempt.
+    // The original surface, built once for every attempt: where the deviation is
+    // measured, and (regular mode) a grid of its triangles for the relaxation.
     let samples = surface_samples(mesh.positions(), &indices);
-    let original_triangles: Vec<[glam::DVec3; 3]> = match mode {
-        SimplifyMode::Regular => indices
+    let regular = mode == SimplifyMode::Regular;
+    let original_triangles: Vec<[glam::DVec3; 3]> = if regular {
+        indices
             .chunks_exact(3)
             .map(|t| [0, 1, 2].map(|k| mesh.positions()[t[k] as usize]))
-            .collect(),
-        SimplifyMode::Accurate => Vec::new(),
+            .collect()
+    } else {
+        Vec::new()
     };
-    let original_grid = super::distance::TriangleGrid::new(&original_triangles);
+    let original_grid = regular.then(|| super::distance::TriangleGrid::new(&original_triangles));
     let input = Input {
         mesh,
         before,
@@ -173,10 +177,11 @@ pub fn simplify(
         locked: &locked,
         budget,
         target,
-        original: Original {
+        samples: &samples,
+        relax_onto: original_grid.as_ref().map(|grid| Surface {
+            grid,
             samples: &samples,
-            grid: (mode == SimplifyMode::Regular).then_some(&original_grid),
-        },
+        }),
     };
     // Regularizing collapses across thin handles more readily (fertility at 600
     // edges loses one of its four): when its result changes the topology or does not
@@ -217,17 +222,10 @@ struct Input<'a> {
     budget: Budget,
     /// First guess at the number of triangles.
     target: usize,
-    /// Where the deviation is measured, and (in regular mode) the original surface
-    /// that relaxation projects onto.
-    original: Original<'a>,
-}
-
-/// The original surface: the samples the deviation is measured at, and a grid of its
-/// triangles when relaxation needs one.
-#[derive(Clone, Copy)]
-struct Original<'a> {
+    /// Where the deviation from the original surface is measured.
     samples: &'a [glam::DVec3],
-    grid: Option<&'a super::distance::TriangleGrid<'a>>,
+    /// The original surface that regular mode relaxes the result onto.
+    relax_onto: Option<Surface<'a>>,
 }
 
 impl Input<'_> {
@@ -320,16 +318,15 @@ impl Input<'_> {
                 loops_after: after.boundary_loops,
             });
         }
-        let samples = self.original.samples;
+        let samples = self.samples;
         let mut relaxed_moves = 0;
         let mut measured = deviation(samples, &simplified);
-        if let Some(grid) = self.original.grid {
+        if let Some(surface) = &self.relax_onto {
             // Relaxing moves vertices only: the connectivity, and so the topology just
             // checked, stay.
             let triangles: Vec<[u32; 3]> = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
             let before = polys.positions.clone();
-            let surface = super::relax::Surface { grid, samples };
-            let relaxed = super::relax::relax(&mut polys.positions, &triangles, &surface);
+            let relaxed = relax(&mut polys.positions, &triangles, surface);
             if relaxed.moves > 0 {
                 // The relaxation's bounds hold up to the rounding of its running sums
                 // (and of the grid's search): keep its result only if the deviation,
