@@ -48,15 +48,11 @@ pub struct Surface<'a> {
 
 /// Relaxes the vertices `positions` of the triangles `triangles` (consistently
 /// oriented, manifold) toward `surface` (see the module documentation). Deterministic:
-/// vertices move one at a time in index order.
-pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface) -> Relaxed {
-    let mut relaxed = Relaxed {
-        moves: 0,
-        largest: 0.0,
-        sum: 0.0,
-    };
+/// vertices move one at a time in index order. Returns the number of moves kept.
+pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface) -> usize {
+    let mut moves = 0;
     if triangles.is_empty() {
-        return relaxed;
+        return moves;
     }
     let rings = Rings::new(positions.len(), triangles);
     // Every face's area vector before relaxing: a face may never turn more than a
@@ -112,7 +108,6 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
         let mut total: f64 = tracked.iter().sum();
         let (limit, budget) =
             *bounds.get_or_insert((tracked.iter().copied().fold(0.0, f64::max), total));
-        (relaxed.largest, relaxed.sum) = (limit, budget);
         let samples_of = samples_per_face(triangles.len(), &nearest);
 
         let mut moved_this_round = 0;
@@ -168,22 +163,12 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
             }
             moved_this_round += 1;
         }
-        relaxed.moves += moved_this_round;
+        moves += moved_this_round;
         if moved_this_round == 0 {
             break;
         }
     }
-    relaxed
-}
-
-/// What [`relax`] did, and the bounds it kept: the largest distance and the sum of the
-/// distances from the samples to the mesh before relaxing (as the samples' nearest
-/// faces gave them; the caller checks the relaxed mesh against them).
-#[derive(Clone, Copy, Debug)]
-pub struct Relaxed {
-    pub moves: usize,
-    pub largest: f64,
-    pub sum: f64,
+    moves
 }
 
 /// Whether the faces `fan` around an interior vertex `v` form a single closed fan:
@@ -422,7 +407,7 @@ mod tests {
             grid: &grid,
             samples: &samples,
         };
-        let moves = relax(&mut relaxed, &faces, &surface).moves;
+        let moves = relax(&mut relaxed, &faces, &surface);
         let after = (
             deviation(&samples, &relaxed, &faces),
             spread(&relaxed, &faces),
