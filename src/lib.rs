@@ -21,6 +21,7 @@ pub mod nest;
 pub mod panel;
 pub mod plane;
 pub mod run;
+pub mod sanity;
 pub mod scheme;
 
 use std::path::Path;
@@ -29,11 +30,33 @@ use serde::Serialize;
 
 pub use config::{BuildOptions, Job, ModelOptions, ModelSettings, NonPlanar};
 pub use error::{Error, InputError, Result};
-pub use run::{report_text, run, Outcome};
+pub use run::{report_text, run, run_observed, Outcome};
 
 use mesh::components::SmallComponents;
 use mesh::read::Group;
 use mesh::{GeometryFacts, Note, PrepareOptions, PreparedModel, SoupFacts, Topology};
+
+/// What to do when a simplification budget was refused: the smallest budget found
+/// that works, or building without simplification.
+fn refused_budget_fix(
+    mesh: &mesh::Mesh,
+    budget: mesh::simplify::Budget,
+    mode: mesh::simplify::SimplifyMode,
+) -> String {
+    use mesh::simplify::Budget;
+    match mesh::simplify::smallest_working_budget(mesh, budget, mode) {
+        Some(Budget::Edges(n)) => {
+            format!("the smallest budget found that keeps it is --target-edges {n}")
+        }
+        Some(Budget::Faces(n)) => {
+            format!("the smallest budget found that keeps it is --target-faces {n}")
+        }
+        None => format!(
+            "no budget below the model's own {} edges keeps it; build it without --target-edges",
+            mesh.edge_count()
+        ),
+    }
+}
 
 /// Reads and prepares a model: the first two stages of every job. Simplification (with
 /// `--target-edges` / `--target-faces`) is part of preparation.
@@ -53,8 +76,12 @@ pub fn load_model(
     }
     if let Some(budget) = settings.budget {
         let (simplified, report) =
-            mesh::simplify::simplify(&prepared.mesh, budget, settings.simplify_mode)
-                .map_err(|e| InputError::new(path, error::Location::File, e.to_string(), ""))?;
+            mesh::simplify::simplify(&prepared.mesh, budget, settings.simplify_mode).map_err(
+                |e| {
+                    let fix = refused_budget_fix(&prepared.mesh, budget, settings.simplify_mode);
+                    InputError::new(path, error::Location::File, e.to_string(), fix)
+                },
+            )?;
         let mode = match report.fallback {
             None => format!("{} mode", settings.simplify_mode),
             Some(used) => format!(

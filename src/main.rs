@@ -19,6 +19,7 @@ use unfold::{Error, Result};
     version,
     args_conflicts_with_subcommands = true,
     subcommand_negates_reqs = true,
+    args_override_self = true,
     after_help = "Lengths take a unit: mm, cm, m, in, ft (4ft, 0.25in, 600mm).\n\
                   Examples:\n  unfold inspect models/genus2.obj\n  \
                   unfold bunny.obj --scheme quad-edge --sheet 18x24in --size 4ft --out build/bunny"
@@ -36,21 +37,13 @@ struct Cli {
     #[arg(long, value_name = "FILE")]
     config: Option<PathBuf>,
 
-    /// Print the manifest summary (without the per-panel list) and stage times as
-    /// JSON on stdout.
-    #[arg(long)]
-    json: bool,
-
-    /// Print nothing on stderr but errors.
-    #[arg(long)]
-    quiet: bool,
-
     #[command(flatten)]
     build: BuildOptions,
 }
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    #[command(args_override_self = true)]
     /// Print a model's topology and geometry (V, E, F, face sizes, boundary loops,
     /// components, genus, size, planarity) and every repair the tool would make.
     Inspect {
@@ -98,8 +91,10 @@ fn main() -> ExitCode {
     }
 }
 
-/// Help and version go to stdout as clap renders them; every other parse error becomes
-/// one line and exit code 2, like every other error of the tool.
+/// Help and version go to stdout as clap renders them. Any other parse error keeps
+/// clap's whole message (the tip of a similar option, the values an option takes, the
+/// missing argument, the usage line), prefixed like every other error of the tool, with
+/// exit code 2.
 fn usage_error(e: clap::Error) -> ExitCode {
     use clap::error::ErrorKind;
     if matches!(
@@ -112,12 +107,8 @@ fn usage_error(e: clap::Error) -> ExitCode {
         return ExitCode::SUCCESS;
     }
     let rendered = e.to_string();
-    let first = rendered
-        .lines()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("invalid arguments")
-        .trim_start_matches("error: ");
-    eprintln!("unfold: error: {first} (see 'unfold --help')");
+    let message = rendered.trim_end().trim_start_matches("error: ");
+    eprintln!("unfold: error: {message}");
     ExitCode::from(2)
 }
 
@@ -135,7 +126,7 @@ fn run(cli: Cli) -> Result<()> {
             // not change preparation and are read but not used.
             let (options, nonplanar) = match config {
                 Some(path) => {
-                    let file = load_config::<BuildOptions>(&path)?;
+                    let file = load_config(&path)?;
                     (options.or(file.model), nonplanar.or(file.nonplanar))
                 }
                 None => (options, nonplanar),
@@ -159,15 +150,20 @@ fn run(cli: Cli) -> Result<()> {
                 .model
                 .ok_or_else(|| Error::Usage("give a model file".to_string()))?;
             let options = match cli.config {
-                Some(path) => cli.build.or(load_config::<BuildOptions>(&path)?),
+                Some(path) => cli.build.or(load_config(&path)?),
                 None => cli.build,
             };
             let job = options.resolve(&model)?;
-            let outcome = unfold::run(&job)?;
-            if !cli.quiet {
+            let quiet = job.quiet;
+            let outcome = unfold::run_observed(&job, &mut |warning| {
+                if !quiet {
+                    eprintln!("unfold: warning: {warning}");
+                }
+            })?;
+            if !job.quiet {
                 eprint!("{}", unfold::report_text(&outcome, &job.out));
             }
-            if cli.json {
+            if job.json {
                 let mut summary = serde_json::to_value(&outcome.manifest)
                     .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?;
                 if let Some(map) = summary.as_object_mut() {

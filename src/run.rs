@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use crate::config::{Job, NonPlanar};
 use crate::error::{Error, InputError, Result};
+use crate::export::folder::{check_output_folder, MANIFEST};
 use crate::export::manifest::{self, round4, Manifest};
 use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
 use crate::flatten::unroll_all;
@@ -155,7 +156,17 @@ pub fn planarize_faces(
 /// Runs a job and writes its output folder (atomically: on any error the folder is
 /// left as it was).
 pub fn run(job: &Job) -> Result<Outcome> {
+    run_observed(job, &mut |_| {})
+}
+
+/// [`run`], handing each warning about the build to `warn` as soon as it is known
+/// (before the long stages), so a user can stop a build that is not what they meant.
+pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let mut clock = Stopwatch::new();
+    // Refused before the long stages: a folder given as the model, and an output
+    // folder that holds files unfold did not write.
+    crate::mesh::read::model_format(&job.model_path)?;
+    let folder = check_output_folder(&job.out, &job.model_path, job.force)?;
     let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
     let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
     clock.lap("load");
@@ -190,6 +201,10 @@ pub fn run(job: &Job) -> Result<Outcome> {
             split.not_star_shaped.len()
         ));
     }
+    let mut size_check = crate::sanity::check_size(job, &mesh)?;
+    for warning in &size_check.warnings {
+        warn(warning);
+    }
     let topology = mesh.topology();
     clock.lap("split");
 
@@ -207,6 +222,10 @@ pub fn run(job: &Job) -> Result<Outcome> {
 
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
         .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
+    if let Some(warning) = crate::sanity::check_labels(job, &mesh, flat.len(), &labels_left_out)? {
+        warn(&warning);
+        size_check.warnings.push(warning);
+    }
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
         // is a projection of a warped polygon.
@@ -325,7 +344,7 @@ pub fn run(job: &Job) -> Result<Outcome> {
         lengths.engrave += sheet.lengths.engrave;
         sheet_entries.push(sheet.entry);
     }
-    let manifest = build_manifest(
+    let mut manifest = build_manifest(
         job,
         &mesh,
         &topology,
@@ -340,14 +359,20 @@ pub fn run(job: &Job) -> Result<Outcome> {
         nesting,
         spacing_bound,
     );
-    let json = serde_json::to_string_pretty(&manifest)
-        .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
-    files.push(("manifest.json".into(), (json + "\n").into_bytes()));
     files.push((
         format!("{name}-assembled.obj"),
         assembled_obj(&output.panels).into_bytes(),
     ));
-    crate::export::write_folder_atomically(&job.out, &files)?;
+    manifest.warnings = size_check.warnings;
+    manifest.files = files
+        .iter()
+        .map(|(n, _)| n.clone())
+        .chain([MANIFEST.to_string()])
+        .collect();
+    let json = serde_json::to_string_pretty(&manifest)
+        .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
+    files.push((MANIFEST.into(), (json + "\n").into_bytes()));
+    notes.extend(folder.write(&files, &job.model_path)?);
     clock.lap("export");
 
     Ok(Outcome {
@@ -483,7 +508,18 @@ fn build_manifest(
                 .fold(0.0, f64::max),
         ),
         sheets,
+        warnings: Vec::new(),
+        files: Vec::new(),
         panels,
+    }
+}
+
+/// A laser path length for the report: millimetres below a metre, metres above.
+fn path_length(mm: f64) -> String {
+    if mm < 1000.0 {
+        format!("{mm:.0} mm")
+    } else {
+        format!("{:.1} m", mm / 1000.0)
     }
 }
 
@@ -495,19 +531,18 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{}: {} scheme, {} panels, {} connections, {} holes",
+        "{}: {} scheme, {} panels, {} connections, {} fastener holes",
         m.input.path, m.scheme.name, c.panels, c.connections, c.holes
     );
     let _ = writeln!(
         s,
-        "sheets: {} of {} ({:.1} x {:.1} mm); area lower bound {} ({} counting the spacing); utilization {:.1}%",
+        "sheets: {} of {} ({:.1} x {:.1} mm), {:.1} % of their area used; at least {} needed for this panel area at this spacing",
         c.sheets,
         m.sheet.name,
         m.sheet.width,
         m.sheet.height,
-        c.sheets_lower_bound,
-        c.sheets_spacing_bound,
-        100.0 * m.utilization
+        100.0 * m.utilization,
+        c.sheets_spacing_bound
     );
     if !m.cycles.is_empty() {
         let edges = m.cycles.iter().map(|y| y.edges);
@@ -528,23 +563,40 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         .collect();
     let _ = writeln!(
         s,
-        "nesting: {} (effort {}, seed {}); shelf baseline {} sheets; sheet fill {}",
+        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {} sheets",
         m.nesting.nester,
         m.nesting.effort,
         m.nesting.seed,
-        m.nesting.shelf_sheets,
-        fills.join(" ")
+        fills.join(" "),
+        m.nesting.shelf_sheets
     );
     let _ = writeln!(
         s,
-        "lengths: cut {:.0} mm, score {:.0} mm, engrave {:.0} mm; max developability error {:.1e} mm",
-        m.lengths.cut, m.lengths.score, m.lengths.engrave, m.max_developability_error
+        "laser paths: cut {}, score {}, engrave {}",
+        path_length(m.lengths.cut),
+        path_length(m.lengths.score),
+        path_length(m.lengths.engrave)
     );
+    // Exact panels carry only float noise, rounded away in the manifest.
+    let error = m.max_developability_error;
+    if error == 0.0 {
+        let _ = writeln!(s, "flat panels: every panel unrolls exactly");
+    } else if error < 1e-3 {
+        let _ = writeln!(
+            s,
+            "flat panels: unrolling changes a facet edge by less than 0.001 mm"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "flat panels: unrolling changes a facet edge by {error:.3} mm at most"
+        );
+    }
     if c.labels_left_out > 0 {
         let marks = c.labels_left_out - c.panel_ids_left_out - c.partner_ids_left_out;
         let _ = writeln!(
             s,
-            "labels left out (no room for a 1.5 mm cap height): {} panel ids, {} partner ids, {} vertex/face marks",
+            "labels left out (no room for a 1.5 mm cap height): {} panel ids, {} partner ids, {} vertex and face marks",
             c.panel_ids_left_out, c.partner_ids_left_out, marks
         );
     }

@@ -1,9 +1,10 @@
 //! Broken models and absurd options through the real binary's main command,
-//! `unfold MODEL --out DIR …` (issue "Hardening"; `tests/bad_inputs.rs` does the same
-//! for `unfold inspect`).
+//! `unfold MODEL --out DIR …` (`tests/bad_inputs.rs` does the same for
+//! `unfold inspect`).
 //!
 //! Every input is generated here, in a temporary folder that also holds the output
-//! folder. Before a run, DIR holds only a sentinel file. A refused run must end with
+//! folder. Before a run, DIR holds an earlier run's output: a sentinel file and the
+//! manifest listing it. A refused run must end with
 //! exactly one line on stderr, `unfold: error: …`, naming the model file or the option,
 //! exit code 2 (options) or 3 (model), nothing on stdout, no panic, DIR holding only the
 //! unchanged sentinel and no new entry beside DIR (the atomic writer's staging folders).
@@ -121,6 +122,10 @@ fn run_cases<T>(
 
 const SENTINEL_NAME: &str = "keep.txt";
 const SENTINEL: &str = "sentinel: a refused run must leave this folder alone\n";
+/// The manifest of an earlier run that wrote the sentinel: the folder is unfold's own,
+/// so a successful run replaces it and a refused one must leave it alone.
+const SENTINEL_MANIFEST: &str =
+    "{\"tool\": {\"name\": \"unfold\"}, \"files\": [\"keep.txt\", \"manifest.json\"]}\n";
 
 /// A temporary folder holding a case's model and the output folder `out`.
 struct Sandbox {
@@ -150,11 +155,13 @@ impl Sandbox {
         self.path("out")
     }
 
-    /// Creates the output folder holding only the sentinel file.
+    /// Creates the output folder of an earlier run: the sentinel file and a manifest
+    /// listing it.
     fn plant_sentinel(&self) -> PathBuf {
         let out = self.out();
         std::fs::create_dir(&out).unwrap();
         std::fs::write(out.join(SENTINEL_NAME), SENTINEL).unwrap();
+        std::fs::write(out.join("manifest.json"), SENTINEL_MANIFEST).unwrap();
         out
     }
 
@@ -189,10 +196,14 @@ fn folder_files(case: &str, dir: &Path) -> BTreeMap<String, String> {
         .collect()
 }
 
-/// The output folder holds only the unchanged sentinel and nothing appeared beside it.
+/// The output folder holds only the unchanged earlier output and nothing appeared
+/// beside it.
 fn assert_untouched(case: &str, sandbox: &Sandbox, before: &BTreeSet<String>) {
     let files = folder_files(case, &sandbox.out());
-    let expected = BTreeMap::from([(SENTINEL_NAME.to_string(), SENTINEL.to_string())]);
+    let expected = BTreeMap::from([
+        (SENTINEL_NAME.to_string(), SENTINEL.to_string()),
+        ("manifest.json".to_string(), SENTINEL_MANIFEST.to_string()),
+    ]);
     assert_eq!(files, expected, "{case}: the output folder was touched");
     assert_eq!(
         &sandbox.entries(),
@@ -745,10 +756,6 @@ const ABSURD_OPTIONS: &[OptionCase] = &[
     (
         &["--format", "png"],
         &["--format: unknown format 'png'; use svg, dxf or svg,dxf"],
-    ),
-    (
-        &["--scheme", "nope"],
-        &["invalid value 'nope' for '--scheme <SCHEME>'"],
     ),
     (
         &["--scale", "nan"],

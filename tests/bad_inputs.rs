@@ -591,7 +591,6 @@ fn nesting_options_out_of_range_are_usage_errors_and_write_nothing() {
         (&["--time-limit", "nan"], "--time-limit"),
         (&["--effort", "0"], "--effort"),
         (&["--effort", "101"], "--effort"),
-        (&["--nester", "tight"], "--nester"),
     ] {
         let run = finish(
             unfold_command()

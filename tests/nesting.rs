@@ -270,7 +270,7 @@ fn true_shapes_need_fewer_sheets_than_shelves_on_small_models() {
             count(&m, "nesting.shelf_sheets"),
             count(&shelf, "counts.sheets")
         );
-        assert!(run.stderr.contains("sheet fill"), "{}", run.stderr);
+        assert!(run.stderr.contains("each sheet filled"), "{}", run.stderr);
     }
 }
 

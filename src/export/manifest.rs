@@ -279,11 +279,18 @@ pub struct Manifest {
     pub lengths: Lengths,
     /// Largest developability error of any panel (mm).
     pub max_developability_error: f64,
+    /// Warnings about the build's size (a forgotten --size, panels too small for
+    /// their labels), each naming its fix.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
     /// Woven cycles (woven scheme only).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub cycles: Vec<CycleEntry>,
     /// The output sheets.
     pub sheets: Vec<SheetEntry>,
+    /// Every file the run wrote into the output folder, this manifest last: a later
+    /// run replaces exactly these and keeps any other file.
+    pub files: Vec<String>,
     /// Every panel.
     pub panels: Vec<PanelEntry>,
 }

@@ -4,6 +4,7 @@
 //! files carry exactly the same geometry.
 
 pub mod dxf;
+pub mod folder;
 pub mod manifest;
 pub mod obj;
 pub mod svg;
@@ -138,75 +139,6 @@ fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetS
             sink.polyline(Kind::Engrave, &points, false);
         }
     }
-}
-
-/// Writes `files` into the folder `out` so that the folder is never half-written: the
-/// files go into a hidden sibling folder first, which then replaces `out` by renames.
-/// On any error the previous contents of `out` stay as they were.
-pub fn write_folder_atomically(
-    out: &std::path::Path,
-    files: &[(String, Vec<u8>)],
-) -> crate::Result<()> {
-    use crate::Error;
-    let fail = |what: &str, path: &std::path::Path, e: std::io::Error| {
-        Error::Runtime(format!(
-            "cannot {what} {}: {e} (choose a writable --out folder)",
-            path.display()
-        ))
-    };
-    let name = out
-        .file_name()
-        .ok_or_else(|| Error::Usage(format!("--out {}: not a folder name", out.display())))?
-        .to_string_lossy()
-        .into_owned();
-    let parent = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    if out.exists() && !out.is_dir() {
-        return Err(Error::Runtime(format!(
-            "--out {} exists and is not a folder; remove it or choose another --out",
-            out.display()
-        )));
-    }
-    std::fs::create_dir_all(&parent).map_err(|e| fail("create", &parent, e))?;
-    let staging = parent.join(format!(".{name}.unfold-new"));
-    let previous = parent.join(format!(".{name}.unfold-old"));
-    for stale in [&staging, &previous] {
-        if stale.exists() {
-            std::fs::remove_dir_all(stale).map_err(|e| fail("remove", stale, e))?;
-        }
-    }
-    let write_all = || -> crate::Result<()> {
-        std::fs::create_dir(&staging).map_err(|e| fail("create", &staging, e))?;
-        for (file, bytes) in files {
-            let path = staging.join(file);
-            std::fs::write(&path, bytes).map_err(|e| fail("write", &path, e))?;
-        }
-        Ok(())
-    };
-    if let Err(e) = write_all() {
-        let _ = std::fs::remove_dir_all(&staging);
-        return Err(e);
-    }
-    let had_previous = out.exists();
-    if had_previous {
-        if let Err(e) = std::fs::rename(out, &previous) {
-            let _ = std::fs::remove_dir_all(&staging);
-            return Err(fail("replace", out, e));
-        }
-    }
-    if let Err(e) = std::fs::rename(&staging, out) {
-        if had_previous {
-            let _ = std::fs::rename(&previous, out);
-        }
-        let _ = std::fs::remove_dir_all(&staging);
-        return Err(fail("replace", out, e));
-    }
-    if had_previous {
-        let _ = std::fs::remove_dir_all(&previous);
-    }
-    Ok(())
 }
 
 /// A length in mm with at most 4 decimals, trailing zeros trimmed, never `-0`, never

@@ -78,7 +78,7 @@ pub struct SimplifyReport {
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum SimplifyError {
     /// The simplified mesh changed topology.
-    #[error("simplifying to {faces} faces would change the topology (genus {genus_before} -> {genus_after}, boundary loops {loops_before} -> {loops_after}); ask for a larger budget")]
+    #[error("simplifying to {faces} faces would change the topology (genus {genus_before} -> {genus_after}, boundary loops {loops_before} -> {loops_after})")]
     Topology {
         faces: usize,
         genus_before: i64,
@@ -87,8 +87,40 @@ pub enum SimplifyError {
         loops_after: usize,
     },
     /// The simplified triangles do not build into a valid mesh.
-    #[error("the simplified mesh is not a valid manifold ({0}); ask for a larger budget")]
+    #[error("simplifying that far does not give a valid manifold ({0})")]
     Invalid(String),
+}
+
+/// After `asked` was refused: the smallest budget of the same kind found to simplify
+/// `mesh` while keeping its topology, searched by growing the budget by half until one
+/// works, then bisecting down to 2 %. `None` when no budget below the mesh's own
+/// count works.
+pub fn smallest_working_budget(mesh: &Mesh, asked: Budget, mode: SimplifyMode) -> Option<Budget> {
+    let (asked, make, limit): (usize, fn(usize) -> Budget, usize) = match asked {
+        Budget::Edges(n) => (n, Budget::Edges, mesh.edge_count()),
+        Budget::Faces(n) => (n, Budget::Faces, mesh.face_count()),
+    };
+    let works = |n: usize| simplify(mesh, make(n), mode).is_ok();
+    let (mut failed, mut next) = (asked, asked);
+    let mut worked = loop {
+        next = (next + next / 2).max(next + 1);
+        if next >= limit {
+            return None;
+        }
+        if works(next) {
+            break next;
+        }
+        failed = next;
+    };
+    while worked - failed > (worked / 50).max(1) {
+        let mid = failed + (worked - failed) / 2;
+        if works(mid) {
+            worked = mid;
+        } else {
+            failed = mid;
+        }
+    }
+    Some(make(worked))
 }
 
 /// Simplifies a triangle mesh toward `budget`. Deterministic: meshoptimizer is

@@ -71,6 +71,31 @@ pub fn finish(cmd: &mut Command) -> Run {
     }
 }
 
+/// A clean refusal with exit code `code`: nothing on stdout, no panic, stderr starting
+/// `unfold: error: ` and holding every fragment of `says`.
+pub fn assert_refusal(case: &str, run: &Run, code: i32, says: &[&str]) {
+    assert_eq!(
+        run.code,
+        Some(code),
+        "{case}: exit code; stderr: {}",
+        run.stderr
+    );
+    assert!(run.stdout.is_empty(), "{case}: stdout: {}", run.stdout);
+    assert!(!run.stderr.contains("panicked"), "{case}: {}", run.stderr);
+    assert!(
+        run.stderr.starts_with("unfold: error: "),
+        "{case}: stderr: {}",
+        run.stderr
+    );
+    for fragment in says {
+        assert!(
+            run.stderr.contains(fragment),
+            "{case}: no {fragment:?} in:\n{}",
+            run.stderr
+        );
+    }
+}
+
 pub fn unfold<I, S>(args: I) -> Run
 where
     I: IntoIterator<Item = S>,

@@ -100,22 +100,7 @@ impl RawModel {
 
 /// Reads a model file. The format comes from the extension.
 pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
-    let Some(format) = Format::from_path(path) else {
-        return Err(InputError::new(
-            path,
-            Location::File,
-            "unknown model format",
-            "give a .obj, .off or .stl file",
-        ));
-    };
-    if path.is_dir() {
-        return Err(InputError::new(
-            path,
-            Location::File,
-            "is a directory, not a model file",
-            "give the path of a .obj, .off or .stl file",
-        ));
-    }
+    let format = model_format(path)?;
     let bytes = std::fs::read(path).map_err(|e| {
         let problem = match e.kind() {
             std::io::ErrorKind::NotFound => "no such file".to_string(),
@@ -130,6 +115,56 @@ pub fn read_model(path: &Path) -> Result<RawModel, InputError> {
         )
     })?;
     parse_model(path, format, &bytes)
+}
+
+/// The format of the model at `path`, from its extension, refusing a folder given as
+/// the model. Cheap: a run checks it before anything else.
+pub fn model_format(path: &Path) -> Result<Format, InputError> {
+    if path.is_dir() {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "is a directory, not a model file",
+            folder_hint(path),
+        ));
+    }
+    let Some(format) = Format::from_path(path) else {
+        return Err(InputError::new(
+            path,
+            Location::File,
+            "unknown model format",
+            "give a .obj, .off or .stl file",
+        ));
+    };
+    Ok(format)
+}
+
+/// What to give instead of a folder: a few of the models in it, by name.
+fn folder_hint(folder: &Path) -> String {
+    let mut models: Vec<PathBuf> = std::fs::read_dir(folder)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_file() && Format::from_path(p).is_some())
+        .collect();
+    models.sort();
+    match models.len() {
+        0 => "give the path of a .obj, .off or .stl file".to_string(),
+        n => {
+            let shown: Vec<String> = models
+                .iter()
+                .take(3)
+                .map(|p| p.display().to_string())
+                .collect();
+            let more = if n > 3 {
+                format!("; {} more are there", n - 3)
+            } else {
+                String::new()
+            };
+            format!("give one model file in it, like {}{more}", shown.join(", "))
+        }
+    }
 }
 
 /// Parses a model file's bytes (already read from `path`, which only names the file in

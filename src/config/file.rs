@@ -1,0 +1,305 @@
+//! The TOML configuration file. Its keys are the main command's long option names
+//! (`sheet = "18x24in"`, `target-edges = 600`, `quiet = true`); every option but
+//! `--config` itself is a key. Each key and value is checked here against the option's
+//! own definition, so a mistake is reported at its line and column, naming the key, the
+//! nearest valid key and what the value should look like.
+
+use std::any::TypeId;
+use std::ops::Range;
+use std::path::Path;
+
+use clap::Args;
+use toml::de::{DeTable, DeValue};
+
+use super::{parse_length, parse_sheet, BuildOptions, ModelOptions};
+use crate::error::{Error, Result};
+
+/// Reads a configuration file into options (every key optional).
+pub fn load_config(path: &Path) -> Result<BuildOptions> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Usage(format!("--config {}: cannot read it: {e}", path.display())))?;
+    let at = |span: Option<Range<usize>>, what: String| {
+        let place = match span {
+            Some(span) => {
+                let (line, column) = line_column(&text, span.start);
+                format!("{}:{line}:{column}", path.display())
+            }
+            None => path.display().to_string(),
+        };
+        Error::Usage(format!("--config {place}: {what}"))
+    };
+    let table = DeTable::parse(&text).map_err(|e| {
+        at(
+            e.span(),
+            format!("not valid TOML: {}", one_line(e.message())),
+        )
+    })?;
+    let options = options();
+    // In file order, so the first mistake reported is the first in the file.
+    let mut entries: Vec<_> = table.get_ref().iter().collect();
+    entries.sort_by_key(|(key, _)| key.span().start);
+    for (key, value) in entries {
+        let name = key.get_ref().as_ref();
+        let Some(option) = options.iter().find(|o| o.key == name) else {
+            return Err(at(Some(key.span()), unknown_key(name, &options)));
+        };
+        check_value(option, value.get_ref()).map_err(|why| {
+            at(
+                Some(value.span()),
+                format!("{name} = {}: {why}", shown(&text, value.span())),
+            )
+        })?;
+    }
+    // Every key and value was checked above; what remains are errors of the
+    // deserializer itself, still placed by their span.
+    let build: BuildOptions =
+        toml::from_str(&text).map_err(|e| at(e.span(), one_line(e.message())))?;
+    let model: ModelOptions =
+        toml::from_str(&text).map_err(|e| at(e.span(), one_line(e.message())))?;
+    Ok(BuildOptions { model, ..build })
+}
+
+/// What values an option takes.
+#[derive(Clone, Debug, PartialEq)]
+enum ValueKind {
+    /// A flag: true or false.
+    Switch,
+    /// One of these names.
+    Choice(Vec<String>),
+    /// A length with a unit, as a string.
+    Length,
+    /// A sheet size, as a string.
+    Sheet,
+    /// A whole number in this range.
+    Whole(i128, i128),
+    /// Any number.
+    Number,
+    /// A path or other text, as a string.
+    Text,
+}
+
+/// One config key and the values it takes.
+#[derive(Clone, Debug)]
+struct ConfigOption {
+    key: String,
+    kind: ValueKind,
+}
+
+/// Every config key, read off the command line's own definitions.
+fn options() -> Vec<ConfigOption> {
+    let command = BuildOptions::augment_args(clap::Command::new("unfold"));
+    command
+        .get_arguments()
+        .filter_map(|arg| {
+            let key = arg.get_long()?.to_string();
+            let kind = if matches!(arg.get_action(), clap::ArgAction::SetTrue) {
+                ValueKind::Switch
+            } else if !arg.get_possible_values().is_empty() {
+                ValueKind::Choice(
+                    arg.get_possible_values()
+                        .iter()
+                        .map(|v| v.get_name().to_string())
+                        .collect(),
+                )
+            } else {
+                let id = arg.get_value_parser().type_id();
+                let value_name = arg
+                    .get_value_names()
+                    .and_then(|names| names.first())
+                    .map(|n| n.as_str())
+                    .unwrap_or("");
+                let whole = |lo: i128, hi: i128| Some(ValueKind::Whole(lo, hi));
+                let by_type = if id == TypeId::of::<u32>() {
+                    whole(0, u32::MAX.into())
+                } else if id == TypeId::of::<u64>() {
+                    whole(0, u64::MAX.into())
+                } else if id == TypeId::of::<usize>() {
+                    whole(0, usize::MAX as i128)
+                } else if id == TypeId::of::<i32>() {
+                    whole(i32::MIN.into(), i32::MAX.into())
+                } else if id == TypeId::of::<f64>() {
+                    Some(ValueKind::Number)
+                } else {
+                    None
+                };
+                by_type.unwrap_or(match value_name {
+                    "LENGTH" => ValueKind::Length,
+                    "SIZE" => ValueKind::Sheet,
+                    _ => ValueKind::Text,
+                })
+            };
+            Some(ConfigOption { key, kind })
+        })
+        .collect()
+}
+
+/// Says why `value` does not fit `option`, in the option's own terms.
+fn check_value(option: &ConfigOption, value: &DeValue) -> std::result::Result<(), String> {
+    let key = &option.key;
+    match (&option.kind, value) {
+        (ValueKind::Switch, DeValue::Boolean(_)) => Ok(()),
+        (ValueKind::Switch, _) => Err(format!("a switch; write {key} = true or {key} = false")),
+        (ValueKind::Choice(names), DeValue::String(s)) if names.iter().any(|n| n == s.as_ref()) => {
+            Ok(())
+        }
+        (ValueKind::Choice(names), _) => Err(format!(
+            "not one of the values it takes; write one of {} in quotes, like {key} = \"{}\"",
+            names.join(", "),
+            names[0]
+        )),
+        (ValueKind::Length, DeValue::String(s)) => parse_length(s).map(|_| ()),
+        (ValueKind::Length, DeValue::Integer(_) | DeValue::Float(_)) => {
+            let number = value_number(value).unwrap_or_default();
+            Err(format!(
+                "a length needs a unit; write it in quotes with one, like {key} = \"{number}mm\", \"{number}in\" or \"{number}ft\""
+            ))
+        }
+        (ValueKind::Length, _) => Err(format!(
+            "a length with a unit, in quotes, like {key} = \"4ft\" (mm, cm, m, in or ft)"
+        )),
+        (ValueKind::Sheet, DeValue::String(s)) => parse_sheet(s).map(|_| ()),
+        (ValueKind::Sheet, _) => Err(format!(
+            "a sheet size in quotes: WxH with a unit or a name, like {key} = \"18x24in\" or \"A2\""
+        )),
+        (ValueKind::Whole(lo, hi), DeValue::Integer(i)) => {
+            let digits = i.as_str().replace('_', "");
+            match i128::from_str_radix(&digits, i.radix()) {
+                Ok(n) if (*lo..=*hi).contains(&n) => Ok(()),
+                _ if *lo == 0 => Err(format!("a whole number, zero or more, like {key} = 4")),
+                _ => Err(format!("a whole number between {lo} and {hi}")),
+            }
+        }
+        (ValueKind::Whole(..), _) => Err(format!("a whole number without quotes, like {key} = 4")),
+        (ValueKind::Number, DeValue::Integer(_) | DeValue::Float(_)) => Ok(()),
+        (ValueKind::Number, _) => Err(format!("a number without quotes, like {key} = 0.5")),
+        (ValueKind::Text, DeValue::String(_)) => Ok(()),
+        (ValueKind::Text, _) => Err(format!(
+            "text in quotes, like {key} = \"{}\"",
+            if key == "out" {
+                "build/bunny"
+            } else {
+                "svg,dxf"
+            }
+        )),
+    }
+}
+
+/// A TOML number as written.
+fn value_number(value: &DeValue) -> Option<String> {
+    match value {
+        DeValue::Integer(i) => Some(i.as_str().to_string()),
+        DeValue::Float(f) => Some(f.as_str().to_string()),
+        _ => None,
+    }
+}
+
+/// The value as the file has it, for the message.
+fn shown(text: &str, span: Range<usize>) -> String {
+    let raw = text.get(span).unwrap_or("").trim();
+    let raw = one_line(raw);
+    if raw.chars().count() > 40 {
+        format!("{}…", raw.chars().take(40).collect::<String>())
+    } else {
+        raw
+    }
+}
+
+/// The message for a key that is not an option, with the nearest one.
+fn unknown_key(name: &str, options: &[ConfigOption]) -> String {
+    let wanted = name.to_ascii_lowercase().replace('_', "-");
+    let nearest = options
+        .iter()
+        .map(|o| (edit_distance(&wanted, &o.key), &o.key))
+        .min();
+    let hint = match nearest {
+        Some((d, key)) if d <= (key.len() / 3).max(2) => format!("; did you mean '{key}'?"),
+        _ => String::new(),
+    };
+    format!(
+        "unknown key '{name}'{hint} Keys are the long option names of unfold --help, with dashes (sheet, size, target-edges, …)"
+    )
+}
+
+/// Levenshtein distance in characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let above = row[j + 1];
+            row[j + 1] = (above + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != cb));
+            diagonal = above;
+        }
+    }
+    row[b.len()]
+}
+
+/// 1-based line and column (in characters) of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = text.get(..offset).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
+}
+
+/// Joins a message's lines with "; " so it reads as one sentence.
+fn one_line(text: &str) -> String {
+    text.lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distances() {
+        assert_eq!(edit_distance("target-edges", "target-edges"), 0);
+        assert_eq!(edit_distance("szie", "size"), 2);
+        assert_eq!(edit_distance("", "abc"), 3);
+    }
+
+    #[test]
+    fn lines_and_columns() {
+        let text = "a = 1\nbb = 2\n";
+        assert_eq!(line_column(text, 0), (1, 1));
+        assert_eq!(line_column(text, 6), (2, 1));
+        assert_eq!(line_column(text, 11), (2, 6));
+    }
+
+    #[test]
+    fn every_option_is_a_key_and_kinds_follow_the_options() {
+        let options = options();
+        let kind = |key: &str| {
+            options
+                .iter()
+                .find(|o| o.key == key)
+                .unwrap_or_else(|| panic!("no key {key}"))
+                .kind
+                .clone()
+        };
+        assert_eq!(kind("size"), ValueKind::Length);
+        assert_eq!(kind("sheet"), ValueKind::Sheet);
+        assert_eq!(kind("quiet"), ValueKind::Switch);
+        assert_eq!(kind("json"), ValueKind::Switch);
+        assert_eq!(kind("face-scale"), ValueKind::Number);
+        assert_eq!(
+            kind("target-edges"),
+            ValueKind::Whole(0, usize::MAX as i128)
+        );
+        assert_eq!(
+            kind("shift"),
+            ValueKind::Whole(i32::MIN.into(), i32::MAX.into())
+        );
+        assert!(matches!(kind("scheme"), ValueKind::Choice(v) if v.len() == 4));
+        assert_eq!(kind("out"), ValueKind::Text);
+    }
+}

@@ -1,0 +1,301 @@
+//! Checks of a build's size, made before the nest (the long stage), that catch a
+//! user's likely mistakes: a forgotten `--size` (a scan in metres read as
+//! millimetres), a model far too large for the sheets, or one so detailed for its size
+//! that its panels cannot carry their ids. Each gives a warning naming the fix with
+//! computed values; `--strict` turns warnings into refusals. A build whose typical edge
+//! is below [`MIN_MEDIAN_EDGE_MM`] is refused outright: no part of it could be cut.
+
+use std::path::Path;
+
+use crate::config::{Job, LengthUnit};
+use crate::error::{Error, Result};
+use crate::labels::LabelOptions;
+use crate::mesh::read::{parse_model, Format};
+use crate::mesh::{prepare, Mesh, PrepareOptions};
+
+/// A build whose median edge is shorter than this (mm) is refused: a laser's kerf is a
+/// tenth of it and the smallest legible label (1.5 mm) does not fit.
+pub const MIN_MEDIAN_EDGE_MM: f64 = 1.0;
+
+/// A model whose longest side is below this fraction of the usable sheet's shorter side
+/// is reported as small for the sheet (a forgotten `--size` builds scans in metres a
+/// few tenths of a millimetre across).
+const SMALL_FOR_SHEET: f64 = 0.1;
+
+/// A model whose surface alone covers more sheets than this is reported as large.
+const LARGE_SHEETS: f64 = 200.0;
+
+/// The sheets a suggested `--size` for a large model covers: a build of a day or two.
+const FEW_SHEETS: f64 = 20.0;
+
+/// Panels are too small for their labels when more than this fraction of their ids is
+/// left out: a builder cannot place a panel without its id.
+const IDS_LEFT_OUT: f64 = 0.01;
+
+/// A suggested budget aims the median edge this many times the smallest edge at which
+/// the scheme's panels on a regular mesh carry their labels: a simplified scan keeps a
+/// tenth of its edges below two thirds of the median (spot at 1,800 edges), and those
+/// must still build.
+const SPREAD_MARGIN: f64 = 2.0;
+
+/// The fraction of the shortest edges a suggested `--size` lets fall below the
+/// smallest buildable edge.
+const SHORT_TAIL: f64 = 0.05;
+
+/// What the checks found: warnings for the report, in order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SizeCheck {
+    /// One sentence each, naming the fix.
+    pub warnings: Vec<String>,
+}
+
+/// Checks the scaled `mesh` of `job` against the sheet. Errors when the build is
+/// hopeless, or with `--strict` when anything was found.
+pub fn check_size(job: &Job, mesh: &Mesh) -> Result<SizeCheck> {
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    if lengths.is_empty() {
+        return Ok(SizeCheck::default());
+    }
+    lengths.sort_by(f64::total_cmp);
+    let median = lengths[lengths.len() / 2];
+    let longest = mesh.longest_side();
+    let model = job.model_path.display();
+    let across = format!("{} across", length_text(longest));
+    let forgot_size = job.model.scaling.size.is_none();
+    let units_hint = || units_hint(job, longest);
+
+    if median < MIN_MEDIAN_EDGE_MM {
+        let why = if forgot_size {
+            format!(
+                "no --size was given, so one model unit is {} mm; {}",
+                short(job.model.scaling.unit_mm * job.model.scaling.scale),
+                units_hint()
+            )
+        } else {
+            "give a larger --size or simplify the model (--target-edges)".to_string()
+        };
+        return Err(Error::Usage(format!(
+            "{model} would be built {across} with a median edge of {} mm, too small for any laser part to be cut; {why}",
+            short(median)
+        )));
+    }
+
+    let mut warnings = Vec::new();
+    let usable_w = job.sheet.width - 2.0 * job.margin;
+    let usable_h = job.sheet.height - 2.0 * job.margin;
+    if forgot_size && longest < SMALL_FOR_SHEET * usable_w.min(usable_h) {
+        warnings.push(format!(
+            "{model} is built only {across} (no --size was given, so one model unit is {} mm); {}",
+            short(job.model.scaling.unit_mm * job.model.scaling.scale),
+            units_hint()
+        ));
+    }
+    let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
+    let sheets = area / (usable_w * usable_h);
+    if sheets > LARGE_SHEETS {
+        let size = longest * (FEW_SHEETS / sheets).sqrt();
+        warnings.push(format!(
+            "{model} is built {across}: its surface alone covers {:.0} sheets of {}; give the size to build with --size (at --size {} it covers about {FEW_SHEETS:.0}) or use a larger --sheet",
+            sheets.ceil(),
+            job.sheet.name,
+            length_text(size)
+        ));
+    }
+    strict(job, &warnings)?;
+    Ok(SizeCheck { warnings })
+}
+
+/// With `--strict`, the first warning as a refusal.
+fn strict(job: &Job, warnings: &[String]) -> Result<()> {
+    match warnings.first() {
+        Some(first) if job.strict => Err(Error::Usage(format!("{first} (refused by --strict)"))),
+        _ => Ok(()),
+    }
+}
+
+/// Checks, after the labels were fitted and before the nest, that the panels carry
+/// their ids: more than [`IDS_LEFT_OUT`] of them left out means the model is too
+/// detailed for its size. The warning gives the budget (and the size) at which the
+/// scheme's panels carry them. With `--strict` it is a refusal.
+pub fn check_labels(
+    job: &Job,
+    mesh: &Mesh,
+    panels: usize,
+    left_out: &crate::labels::LeftOut,
+) -> Result<Option<String>> {
+    if panels == 0 || (left_out.panel as f64) <= IDS_LEFT_OUT * panels as f64 {
+        return Ok(None);
+    }
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    lengths.sort_by(f64::total_cmp);
+    let buildable = smallest_buildable_edge(job, mesh);
+    let warning = too_detailed(job, mesh, &lengths, buildable, panels, left_out);
+    strict(job, std::slice::from_ref(&warning))?;
+    Ok(Some(warning))
+}
+
+/// The warning for panels too small for their labels, with the budget (and the size)
+/// that makes them carry their ids.
+fn too_detailed(
+    job: &Job,
+    mesh: &Mesh,
+    lengths: &[f64],
+    buildable: Option<f64>,
+    panels: usize,
+    left_out: &crate::labels::LeftOut,
+) -> String {
+    let mut fixes = Vec::new();
+    if let (Some(buildable), false) = (buildable, lengths.is_empty()) {
+        let median = lengths[lengths.len() / 2];
+        let edges = lengths.len() as f64;
+        let triangles = mesh.faces().all(|f| mesh.face_degree(f) == 3);
+        if triangles {
+            // At a fixed surface the edge count goes with the inverse square of the
+            // edge length.
+            let target = round_down_2(edges * (median / (SPREAD_MARGIN * buildable)).powi(2));
+            if target >= 6.0 && target < edges {
+                fixes.push(format!("--target-edges {target:.0}"));
+            }
+        }
+        // Or build it larger: the short edges grow with the model.
+        let short = lengths[(lengths.len() as f64 * SHORT_TAIL) as usize];
+        if short < buildable {
+            let size = mesh.longest_side() * buildable / short;
+            fixes.push(format!("--size {}", length_text(size)));
+        }
+    }
+    let fix = if fixes.is_empty() {
+        "simplify the model (--target-edges) or build it larger (--size)".to_string()
+    } else {
+        format!("try {}", fixes.join(" or "))
+    };
+    format!(
+        "the model is too detailed for its size: {} of {panels} {} panels have no room for their id and {} partner ids are left out; {fix}",
+        left_out.panel, job.scheme, left_out.partner
+    )
+}
+
+/// The smallest edge length (mm) at which the job's scheme, on a regular mesh of the
+/// job's kind of faces, gives every panel its id and every connection its partner ids;
+/// found by building that mesh at trial sizes with the job's own options. `None` when
+/// no trial size up to 2 m fits them. Holes are not asked for: where flaps are too
+/// small for them the scheme's own note counts the connections without.
+pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
+    let mut degrees: Vec<usize> = mesh.faces().map(|f| mesh.face_degree(f)).collect();
+    degrees.sort_unstable();
+    let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
+    let text: &[u8] = match typical {
+        3 => include_bytes!("../models/icosahedron.obj"),
+        4 => include_bytes!("../models/hexahedron.obj"),
+        _ => include_bytes!("../models/dodecahedron.obj"),
+    };
+    let raw = parse_model(Path::new("probe.obj"), Format::Obj, text).ok()?;
+    let probe = prepare(&raw, &PrepareOptions { weld: false }).ok()?.mesh;
+    let edge = probe.edges().next().map(|e| probe.edge_length(e))?;
+    let labels_fit = |length: f64| -> bool {
+        let mut scaled = probe.clone();
+        scaled.scale(length / edge);
+        let Ok(output) = crate::scheme::build_panels(job.scheme, &scaled, &job.scheme_options)
+        else {
+            return false;
+        };
+        crate::flatten::unroll_all(&output.panels, LabelOptions::default())
+            .is_ok_and(|(_, left_out)| left_out.panel == 0 && left_out.partner == 0)
+    };
+    // Bisection on a log scale between 0.5 mm and 2 m, to 2 %.
+    let (mut lo, mut hi) = (0.5f64, 2000.0f64);
+    if !labels_fit(hi) {
+        return None;
+    }
+    if labels_fit(lo) {
+        return Some(lo);
+    }
+    while hi / lo > 1.02 {
+        let mid = (lo * hi).sqrt();
+        if labels_fit(mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Some(hi)
+}
+
+/// How large the model would be in other units, for a forgotten `--size`.
+fn units_hint(job: &Job, longest_mm: f64) -> String {
+    let unit_mm = job.model.scaling.unit_mm * job.model.scaling.scale;
+    let units = longest_mm / unit_mm;
+    let plausible: Vec<String> = [
+        (LengthUnit::M, "m"),
+        (LengthUnit::Cm, "cm"),
+        (LengthUnit::In, "in"),
+        (LengthUnit::Ft, "ft"),
+    ]
+    .into_iter()
+    .filter(|(unit, _)| unit.mm() > unit_mm)
+    .filter_map(|(unit, name)| {
+        let built = units * unit.mm() * job.model.scaling.scale;
+        (50.0..=20_000.0)
+            .contains(&built)
+            .then(|| format!("--units {name} builds it {}", length_text(built)))
+    })
+    .collect();
+    let mut hint = String::from("give the size to build it, like --size 4ft");
+    if !plausible.is_empty() {
+        hint.push_str(&format!(", or the model's units: {}", plausible.join(", ")));
+    }
+    hint
+}
+
+/// A length for a message: mm below 10 cm, cm below a metre, m above.
+fn length_text(mm: f64) -> String {
+    if mm < 100.0 {
+        format!("{}mm", short(mm))
+    } else if mm < 1000.0 {
+        format!("{}cm", short(mm / 10.0))
+    } else {
+        format!("{}m", short(mm / 1000.0))
+    }
+}
+
+/// Three significant digits, trailing zeros trimmed, never an exponent.
+fn short(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (2 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// Rounds down to two significant digits (a budget to type, not a false precision).
+fn round_down_2(x: f64) -> f64 {
+    if x <= 0.0 {
+        return 0.0;
+    }
+    let step = 10f64.powi(x.log10().floor() as i32 - 1).max(1.0);
+    (x / step).floor() * step
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn budgets_round_down_to_two_digits() {
+        assert_eq!(round_down_2(1234.0), 1200.0);
+        assert_eq!(round_down_2(99.9), 99.0);
+        assert_eq!(round_down_2(7.5), 7.0);
+    }
+
+    #[test]
+    fn lengths_read_naturally() {
+        assert_eq!(length_text(0.155), "0.155mm");
+        assert_eq!(length_text(155.0), "15.5cm");
+        assert_eq!(length_text(1219.2), "1.22m");
+    }
+}

@@ -1,0 +1,203 @@
+//! The checks of a build's size through the real binary: a forgotten `--size` on a
+//! model in metres is refused at once with the units that would make sense; a model
+//! small or large for the sheet warns (and `--strict` refuses, writing nothing); a
+//! model too detailed for its size warns with a `--target-edges` value that, run, gives
+//! panels that carry their ids.
+
+mod common;
+
+use std::path::Path;
+
+use tempfile::TempDir;
+
+use common::build::{
+    assert_refusal, count, finish, model, read_manifest, shared_models, unfold_command, Run,
+};
+
+fn build(model: &Path, out: &Path, args: &[&str]) -> Run {
+    finish(unfold_command().arg(model).arg("--out").arg(out).args(args))
+}
+
+/// The project's tetrahedron (100 units across) with every coordinate times `k`.
+fn scaled_tetrahedron(dir: &Path, k: f64) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(model("tetrahedron")).unwrap();
+    let scaled: String = text
+        .lines()
+        .map(|line| match line.strip_prefix("v ") {
+            Some(coords) => {
+                let xyz: Vec<String> = coords
+                    .split_whitespace()
+                    .map(|c| (c.parse::<f64>().unwrap() * k).to_string())
+                    .collect();
+                format!("v {}\n", xyz.join(" "))
+            }
+            None => format!("{line}\n"),
+        })
+        .collect();
+    let path = dir.join("tetrahedron.obj");
+    std::fs::write(&path, scaled).unwrap();
+    path
+}
+
+/// Exit 2 with every fragment, and the output folder not written.
+fn assert_refused(case: &str, run: &Run, out: &Path, says: &[&str]) {
+    assert_refusal(case, run, 2, says);
+    assert!(!out.exists(), "{case}: {} was written", out.display());
+}
+
+#[test]
+fn a_model_in_metres_without_size_is_refused_with_the_units_that_fit() {
+    let tmp = TempDir::new().unwrap();
+    // 20 cm across in metres: read as millimetres it is 0.2 mm, edges of 0.28 mm.
+    let metres = scaled_tetrahedron(tmp.path(), 0.002);
+    let out = tmp.path().join("out");
+    let run = build(&metres, &out, &[]);
+    assert_refused(
+        "tetrahedron in metres",
+        &run,
+        &out,
+        &[
+            "too small for any laser part to be cut",
+            "no --size was given",
+            "--size 4ft",
+            "--units m builds it 20cm",
+        ],
+    );
+    // With the units it names, the same model builds.
+    let run = build(&metres, &out, &["--units", "m", "--quiet"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+}
+
+#[test]
+fn the_forgotten_size_of_shared_scans_is_refused_at_once() {
+    let Some(shared) = shared_models("the_forgotten_size_of_shared_scans_is_refused_at_once")
+    else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&shared.join("stanford-bunny.obj"), &out, &[]);
+    assert_refused(
+        "bunny without --size",
+        &run,
+        &out,
+        &[
+            "0.156mm across",
+            "no --size was given",
+            "--units m builds it 15.6cm",
+        ],
+    );
+    let run = build(
+        &shared.join("horse_quad.obj"),
+        &out,
+        &["--scheme", "quad-edge"],
+    );
+    assert_refused("horse_quad without --size", &run, &out, &["--size 4ft"]);
+}
+
+#[test]
+fn a_model_small_for_the_sheet_warns_and_strict_refuses() {
+    let tmp = TempDir::new().unwrap();
+    // 30 mm across on an 18x24in sheet, no --size: a warning, then the build.
+    let small = scaled_tetrahedron(tmp.path(), 0.3);
+    let out = tmp.path().join("out");
+    let run = build(&small, &out, &["--strict"]);
+    assert_refused(
+        "--strict",
+        &run,
+        &out,
+        &[
+            "is built only 30mm across",
+            "--size 4ft",
+            "refused by --strict",
+        ],
+    );
+    let run = build(&small, &out, &[]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(
+        run.stderr.starts_with("unfold: warning: ")
+            && run.stderr.contains("is built only 30mm across"),
+        "{}",
+        run.stderr
+    );
+    let manifest = read_manifest(&out);
+    let warnings = manifest["warnings"]
+        .as_array()
+        .expect("warnings in the manifest");
+    assert!(warnings[0].as_str().unwrap().contains("30mm across"));
+    // --quiet silences the warning on stderr, not in the manifest.
+    let run = build(&small, &out, &["--quiet"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(run.stderr.is_empty(), "{}", run.stderr);
+    assert!(read_manifest(&out)["warnings"].is_array());
+}
+
+#[test]
+fn a_model_large_for_the_sheet_is_refused_under_strict() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&model("tetrahedron"), &out, &["--size", "100m", "--strict"]);
+    assert_refused(
+        "100 m tetrahedron",
+        &run,
+        &out,
+        &[
+            "is built 100m across",
+            "sheets of 18x24in",
+            "it covers about 20)",
+            "or use a larger --sheet",
+        ],
+    );
+}
+
+#[test]
+fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
+    let Some(shared) = shared_models("a_model_too_detailed_for_its_size_gets_a_budget_that_builds")
+    else {
+        return;
+    };
+    let spot = shared.join("spot.obj");
+    let tmp = TempDir::new().unwrap();
+    for scheme in ["quad-edge", "half-edge"] {
+        let out = tmp.path().join(scheme);
+        let args = ["--scheme", scheme, "--size", "3ft", "--effort", "1"];
+        let mut strict = args.to_vec();
+        strict.push("--strict");
+        let run = build(&spot, &out, &strict);
+        assert_refused(
+            scheme,
+            &run,
+            &out,
+            &["too detailed for its size", "--target-edges "],
+        );
+        let at = run.stderr.find("--target-edges ").unwrap() + "--target-edges ".len();
+        let budget: String = run.stderr[at..]
+            .chars()
+            .take_while(char::is_ascii_digit)
+            .collect();
+        let budget_edges: usize = budget.parse().unwrap();
+        assert!(
+            budget_edges < 8784,
+            "{scheme}: {budget_edges} edges suggested"
+        );
+        // The suggested budget, run, carries the panels' ids: no warning, and at most
+        // the checked fraction (1 %) of ids left out.
+        let mut suggested = args.to_vec();
+        suggested.extend(["--target-edges", &budget, "--strict", "--quiet"]);
+        let run = build(&spot, &out, &suggested);
+        assert_eq!(
+            run.code,
+            Some(0),
+            "{scheme} at {budget} edges: {}",
+            run.stderr
+        );
+        let manifest = read_manifest(&out);
+        let panels = count(&manifest, "counts.panels");
+        let ids_out = count(&manifest, "counts.panel_ids_left_out");
+        assert!(
+            ids_out * 100 <= panels,
+            "{scheme} at {budget} edges: {ids_out} of {panels} panel ids left out"
+        );
+        assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");
+    }
+}
