@@ -153,8 +153,9 @@ pub fn planarize_faces(
     })
 }
 
-/// Runs a job and writes its output folder (atomically: on any error the folder is
-/// left as it was).
+/// Runs a job and writes its output folder (replaced whole by a swap, so on any error
+/// the folder is left as it was; see [`crate::export::folder`] for the cases written
+/// in place).
 pub fn run(job: &Job) -> Result<Outcome> {
     run_observed(job, &mut |_| {})
 }

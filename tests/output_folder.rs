@@ -321,3 +321,61 @@ fn a_file_in_the_way_of_out_is_named() {
     );
     assert_eq!(tree(tmp.path()), before);
 }
+
+#[test]
+fn an_older_manifest_does_not_make_the_users_dxf_files_ours() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&model("tetrahedron"), &out, &[]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    // A manifest of an older unfold lists only the sheets' SVG files; older runs wrote
+    // no DXF by default, so a DXF beside a sheet may be the user's own.
+    let path = out.join("manifest.json");
+    let mut manifest: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    manifest.as_object_mut().unwrap().remove("files");
+    std::fs::write(&path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
+    std::fs::write(out.join("tetrahedron-01.dxf"), "my own drawing\n").unwrap();
+    let before = tree(tmp.path());
+    let run = build(&model("tetrahedron"), &out, &[]);
+    assert_refused(
+        "user's DXF",
+        &run,
+        &["tetrahedron-01.dxf", "unfold did not write"],
+    );
+    assert_eq!(tree(tmp.path()), before);
+    // Without it the older folder is unfold's (its assembled model carries unfold's
+    // first line) and is replaced.
+    std::fs::remove_file(out.join("tetrahedron-01.dxf")).unwrap();
+    let run = build(&model("tetrahedron"), &out, &[]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(read_manifest(&out)["files"].is_array());
+}
+
+#[cfg(unix)]
+#[test]
+fn a_replaced_folder_keeps_its_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::set_permissions(&out, std::fs::Permissions::from_mode(0o2750)).unwrap();
+    for _ in 0..2 {
+        let run = build(&model("tetrahedron"), &out, &[]);
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o2750, "mode {mode:o}");
+    }
+}
+
+#[test]
+fn force_with_a_case_variant_of_an_output_name_is_refused() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("Tetrahedron-01.SVG"), "<svg>mine</svg>\n").unwrap();
+    let before = tree(tmp.path());
+    let run = build(&model("tetrahedron"), &out, &["--force"]);
+    assert_refused("case variant", &run, &["tetrahedron-01.svg"]);
+    assert_eq!(tree(tmp.path()), before);
+}

@@ -134,9 +134,13 @@ impl OutputFolder {
             entries.push(name);
         }
         entries.sort();
+        let is_assembled_model = |name: &str| {
+            std::fs::read(self.target.join(name))
+                .is_ok_and(|bytes| bytes.starts_with(ASSEMBLED_HEADER.as_bytes()))
+        };
         let listed = std::fs::read(self.target.join(MANIFEST))
             .ok()
-            .and_then(|bytes| listed_files(&bytes))
+            .and_then(|bytes| listed_files(&bytes, is_assembled_model))
             .filter(|_| plain_files.contains(MANIFEST));
         let ours: BTreeSet<String> = match listed {
             Some(listed) => listed
@@ -199,61 +203,82 @@ impl OutputFolder {
     }
 
     /// Writes `files` (name, bytes) as the folder's new contents. Checks the folder
-    /// again first (it may have changed during the build). Without foreign files the
-    /// folder is replaced whole by a swap; with them (`--force`), or when the folder
-    /// holds the working directory, the files are moved in one by one and only the
-    /// earlier run's files that this run does not write again are removed. Returns
-    /// notes for the report.
+    /// again first (it may have changed during the build). A missing folder, or one
+    /// holding only an earlier run's files, is replaced whole by a swap with a staged
+    /// sibling, which takes the old folder's permissions and owner. The files are moved
+    /// in one by one instead, keeping the folder itself, when it holds foreign files
+    /// (`--force`), holds the working directory, is a mount point or sits in a folder
+    /// where no sibling can be made. Returns notes for the report.
     pub fn write(&self, files: &[(String, Vec<u8>)], model: &Path) -> Result<Vec<String>> {
-        let contents = self.contents()?;
-        if let Some(contents) = &contents {
-            self.check_contents(contents, model)?;
-            if let Some(name) = files.iter().map(|(n, _)| n).find(|n| {
-                contents
-                    .foreign
-                    .iter()
-                    .any(|f| f.to_str() == Some(n.as_str()))
-            }) {
-                return Err(self.usage(format!(
-                    "{name} is there and was not written by unfold; this run would overwrite it. Move it or choose another --out"
-                )));
-            }
-        }
-        let parent = self.target.parent().unwrap_or(Path::new("."));
-        std::fs::create_dir_all(parent).map_err(|e| fail("create", parent, e))?;
-        let staging = self.fresh_sibling("new")?;
-        if let Err(e) = write_files(&staging, files) {
-            remove_listed(&staging, files.iter().map(|(n, _)| n.as_str()));
-            let _ = std::fs::remove_dir(&staging);
-            return Err(e);
+        let Some(contents) = self.contents()? else {
+            let parent = self.target.parent().unwrap_or(Path::new("."));
+            std::fs::create_dir_all(parent).map_err(|e| fail("create", parent, e))?;
+            let staging = self.fresh_dir(parent, &self.sibling_name("new"))?;
+            stage(&staging, files)?;
+            return self.swap_in(&staging, None);
+        };
+        self.check_contents(&contents, model)?;
+        // Case-insensitive file systems would let `Bunny-01.svg` be overwritten by
+        // `bunny-01.svg`: compare without case.
+        if let Some(name) = files.iter().map(|(n, _)| n).find(|n| {
+            contents.foreign.iter().any(|f| {
+                f.to_str()
+                    .is_some_and(|f| f.eq_ignore_ascii_case(n.as_str()))
+            })
+        }) {
+            return Err(self.usage(format!(
+                "{name} is there and was not written by unfold; this run would overwrite it. Move it or choose another --out"
+            )));
         }
         let holds_cwd = std::env::current_dir()
             .ok()
             .and_then(|cwd| std::fs::canonicalize(cwd).ok())
             .is_some_and(|cwd| cwd.starts_with(&self.target));
-        match contents {
-            None => self.swap_in(&staging, None),
-            Some(c) if c.foreign.is_empty() && !holds_cwd => self.swap_in(&staging, Some(&c)),
-            Some(c) => self.move_in(&staging, files, &c),
+        if contents.foreign.is_empty() && !holds_cwd && !self.is_mount_point() {
+            let parent = self.target.parent().unwrap_or(Path::new("."));
+            if let Ok(staging) = self.fresh_dir(parent, &self.sibling_name("new")) {
+                stage(&staging, files)?;
+                return self.swap_in(&staging, Some(&contents));
+            }
         }
+        self.write_in_place(files, &contents)
     }
 
-    /// A new hidden folder beside the target, `.NAME.unfold-KIND-PID[-N]`.
-    fn fresh_sibling(&self, kind: &str) -> Result<PathBuf> {
-        let parent = self.target.parent().unwrap_or(Path::new("."));
+    /// `.NAME.unfold-KIND-PID`, the hidden sibling folders of a swap.
+    fn sibling_name(&self, kind: &str) -> String {
         let name = self
             .target
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let pid = std::process::id();
+        format!(".{name}.unfold-{kind}-{}", std::process::id())
+    }
+
+    /// True when the folder is on another device than its parent (a mount point,
+    /// which cannot be renamed).
+    fn is_mount_point(&self) -> bool {
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let parent = self.target.parent().unwrap_or(Path::new("."));
+            match (std::fs::metadata(&self.target), std::fs::metadata(parent)) {
+                (Ok(t), Ok(p)) => t.dev() != p.dev(),
+                _ => false,
+            }
+        }
+        #[cfg(not(unix))]
+        false
+    }
+
+    /// A new folder `NAME[-N]` in `parent`.
+    fn fresh_dir(&self, parent: &Path, name: &str) -> Result<PathBuf> {
         for attempt in 0..1000 {
             let suffix = if attempt == 0 {
                 String::new()
             } else {
                 format!("-{attempt}")
             };
-            let path = parent.join(format!(".{name}.unfold-{kind}-{pid}{suffix}"));
+            let path = parent.join(format!("{name}{suffix}"));
             match std::fs::create_dir(&path) {
                 Ok(()) => return Ok(path),
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
@@ -261,8 +286,8 @@ impl OutputFolder {
             }
         }
         Err(Error::Runtime(format!(
-            "cannot create a staging folder beside {}: a thousand names are taken",
-            self.target.display()
+            "cannot create a staging folder in {}: a thousand names are taken",
+            parent.display()
         )))
     }
 
@@ -284,7 +309,9 @@ impl OutputFolder {
             }
             return Ok(Vec::new());
         };
-        let old = match self.fresh_sibling("old") {
+        keep_folder_attributes(&self.target, staging);
+        let parent = self.target.parent().unwrap_or(Path::new("."));
+        let old = match self.fresh_dir(parent, &self.sibling_name("old")) {
             Ok(old) => old,
             Err(e) => {
                 cleanup_staging();
@@ -314,37 +341,92 @@ impl OutputFolder {
         Ok(Vec::new())
     }
 
-    /// Moves the staged files into the folder one by one (each replacing the earlier
-    /// run's file of its name), the manifest last, then removes the earlier run's files
-    /// that this run did not write again. Every other file stays.
-    fn move_in(
+    /// Writes the files into the folder itself: staged in a hidden folder inside it
+    /// (so every move is a rename on one device), then moved in one by one, the
+    /// manifest last, and the earlier run's files that this run did not write again
+    /// removed. First the manifest is replaced by one listing the earlier run's files
+    /// and this run's together, so that if the run stops halfway every file of unfold's
+    /// in the folder is still listed and the next run can replace it.
+    fn write_in_place(
+        &self,
+        files: &[(String, Vec<u8>)],
+        previous: &Contents,
+    ) -> Result<Vec<String>> {
+        let staging =
+            self.fresh_dir(&self.target, &format!(".unfold-new-{}", std::process::id()))?;
+        let result = self.move_from(&staging, files, previous);
+        remove_listed(&staging, files.iter().map(|(n, _)| n.as_str()));
+        remove_listed(&staging, [PROVISIONAL].into_iter());
+        let _ = std::fs::remove_dir(&staging);
+        result
+    }
+
+    fn move_from(
         &self,
         staging: &Path,
         files: &[(String, Vec<u8>)],
         previous: &Contents,
     ) -> Result<Vec<String>> {
-        let (manifest, rest): (Vec<&String>, Vec<&String>) =
-            files.iter().map(|(n, _)| n).partition(|n| *n == MANIFEST);
-        for name in rest.into_iter().chain(manifest) {
-            let to = self.target.join(name);
-            if let Err(e) = std::fs::rename(staging.join(name), &to) {
-                remove_listed(staging, files.iter().map(|(n, _)| n.as_str()));
-                let _ = std::fs::remove_dir(staging);
-                return Err(fail("write", &to, e));
-            }
+        let names: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        let mut all: BTreeSet<&str> = previous.ours.iter().map(String::as_str).collect();
+        all.extend(names.iter().copied());
+        let provisional = serde_json::json!({
+            "tool": {"name": "unfold", "version": env!("CARGO_PKG_VERSION")},
+            "incomplete": "a run writing this folder stopped before it finished; run it again",
+            "files": all.iter().collect::<Vec<_>>(),
+        });
+        let provisional = format!("{provisional:#}\n");
+        write_files(staging, files)?;
+        write_files(
+            staging,
+            &[(PROVISIONAL.to_string(), provisional.into_bytes())],
+        )?;
+        let into = |from: &str, to: &str| {
+            let to = self.target.join(to);
+            std::fs::rename(staging.join(from), &to).map_err(|e| fail("write", &to, e))
+        };
+        into(PROVISIONAL, MANIFEST)?;
+        for name in names.iter().filter(|n| **n != MANIFEST) {
+            into(name, name)?;
         }
-        let _ = std::fs::remove_dir(staging);
-        let written: BTreeSet<&str> = files.iter().map(|(n, _)| n.as_str()).collect();
+        if names.contains(MANIFEST) {
+            into(MANIFEST, MANIFEST)?;
+        }
         remove_listed(
             &self.target,
             previous
                 .ours
                 .iter()
                 .map(String::as_str)
-                .filter(|n| !written.contains(n)),
+                .filter(|n| !names.contains(n)),
         );
         Ok(Vec::new())
     }
+}
+
+/// The staged manifest that lists an unfinished in-place write.
+const PROVISIONAL: &str = "manifest.json.provisional";
+
+/// Writes `files` into the fresh folder `staging`; on failure removes them and it.
+fn stage(staging: &Path, files: &[(String, Vec<u8>)]) -> Result<()> {
+    write_files(staging, files).inspect_err(|_| {
+        remove_listed(staging, files.iter().map(|(n, _)| n.as_str()));
+        let _ = std::fs::remove_dir(staging);
+    })
+}
+
+/// Gives `staged` the permissions and (where allowed) the owner and group of the
+/// folder `old` it replaces, so a shared folder stays shared.
+fn keep_folder_attributes(old: &Path, staged: &Path) {
+    let Ok(meta) = std::fs::metadata(old) else {
+        return;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        let _ = std::os::unix::fs::chown(staged, Some(meta.uid()), Some(meta.gid()));
+    }
+    let _ = std::fs::set_permissions(staged, meta.permissions());
 }
 
 /// Writes every file into `dir`.
@@ -371,9 +453,14 @@ fn fail(what: &str, path: &Path, e: std::io::Error) -> Error {
 }
 
 /// The files an earlier run's manifest says it wrote, or `None` when the bytes are not
-/// a manifest of unfold's. Manifests list their files under `files`; older ones list
-/// only each sheet's SVG, whose DXF and the assembled OBJ are then implied.
-fn listed_files(bytes: &[u8]) -> Option<BTreeSet<String>> {
+/// a manifest of unfold's. Manifests list their files under `files`. Older ones list
+/// only each sheet's SVG; of what they leave out, only the assembled model is known to
+/// be unfold's, by the first line it always has (`is_assembled_model` reads it): a DXF
+/// beside the SVG may be the user's own, since older runs wrote none by default.
+fn listed_files(
+    bytes: &[u8],
+    is_assembled_model: impl Fn(&str) -> bool,
+) -> Option<BTreeSet<String>> {
     let manifest: serde_json::Value = serde_json::from_slice(bytes).ok()?;
     if manifest.pointer("/tool/name")?.as_str()? != "unfold" {
         return None;
@@ -391,15 +478,14 @@ fn listed_files(bytes: &[u8]) -> Option<BTreeSet<String>> {
         None => {
             let mut names = Vec::new();
             for sheet in manifest.get("sheets")?.as_array()? {
-                let svg = sheet.get("file")?.as_str()?;
-                names.push(svg.to_string());
-                if let Some(stem) = svg.strip_suffix(".svg") {
-                    names.push(format!("{stem}.dxf"));
-                }
+                names.push(sheet.get("file")?.as_str()?.to_string());
             }
             let input = manifest.pointer("/input/path")?.as_str()?;
             if let Some(stem) = Path::new(input).file_stem() {
-                names.push(format!("{}-assembled.obj", stem.to_string_lossy()));
+                let obj = format!("{}-assembled.obj", stem.to_string_lossy());
+                if is_assembled_model(&obj) {
+                    names.push(obj);
+                }
             }
             names
         }
@@ -407,30 +493,37 @@ fn listed_files(bytes: &[u8]) -> Option<BTreeSet<String>> {
     Some(names.into_iter().filter(|n| plain(n)).collect())
 }
 
+/// The first line of every assembled model unfold writes.
+pub const ASSEMBLED_HEADER: &str = "# unfold: panels as assembled";
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn manifests_of_other_tools_list_nothing() {
-        assert_eq!(listed_files(b"{\"tool\": {\"name\": \"other\"}}"), None);
-        assert_eq!(listed_files(b"not json"), None);
+        assert_eq!(
+            listed_files(b"{\"tool\": {\"name\": \"other\"}}", |_| true),
+            None
+        );
+        assert_eq!(listed_files(b"not json", |_| true), None);
         let listed = listed_files(
             b"{\"tool\": {\"name\": \"unfold\"}, \"files\": [\"a.svg\", \"../x\", \"sub/y\"]}",
+            |_| true,
         )
         .unwrap();
         assert_eq!(listed, BTreeSet::from(["a.svg".to_string()]));
     }
 
     #[test]
-    fn older_manifests_imply_the_dxf_and_the_assembled_model() {
-        let listed = listed_files(
-            b"{\"tool\": {\"name\": \"unfold\"}, \"input\": {\"path\": \"models/cube.obj\"}, \"sheets\": [{\"file\": \"cube-01.svg\"}]}",
-        )
-        .unwrap();
-        let want: BTreeSet<String> = ["cube-01.svg", "cube-01.dxf", "cube-assembled.obj"]
+    fn older_manifests_imply_only_the_assembled_model_that_is_unfolds() {
+        let older = b"{\"tool\": {\"name\": \"unfold\"}, \"input\": {\"path\": \"models/cube.obj\"}, \"sheets\": [{\"file\": \"cube-01.svg\"}]}";
+        let listed = listed_files(older, |name| name == "cube-assembled.obj").unwrap();
+        let want: BTreeSet<String> = ["cube-01.svg", "cube-assembled.obj"]
             .map(String::from)
             .into();
         assert_eq!(listed, want);
+        let listed = listed_files(older, |_| false).unwrap();
+        assert_eq!(listed, BTreeSet::from(["cube-01.svg".to_string()]));
     }
 }

@@ -8,7 +8,7 @@ use crate::panel::Panels;
 
 /// The OBJ text of the panels as they sit in the model.
 pub fn assembled_obj(panels: &Panels) -> String {
-    let mut out = String::from("# unfold: panels as assembled (mm)\n");
+    let mut out = format!("{} (mm)\n", super::folder::ASSEMBLED_HEADER);
     let mut base = 1usize;
     for panel in panels {
         let _ = writeln!(out, "o {}", panel.id());
