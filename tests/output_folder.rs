@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 
 use tempfile::TempDir;
 
-use common::build::{assert_refusal, finish, model, read_manifest, unfold_command, Run};
+use common::build::{
+    assert_refusal, entry_names, finish, model, read_manifest, unfold_command, Run,
+};
 
 /// Every entry under `root` (files with their bytes, folders and links marked), by
 /// path relative to `root`.
@@ -38,14 +40,9 @@ fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     found
 }
 
-/// Names of the plain files directly in `dir`.
+/// Names of the entries directly in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
+    entry_names(dir).into_iter().collect()
 }
 
 /// A folder holding a model, a document, a dotfile and a subfolder with a file.

@@ -10,7 +10,9 @@ use std::path::Path;
 
 use tempfile::TempDir;
 
-use common::build::{assert_refusal, finish, model, read_manifest, unfold_command, Run};
+use common::build::{
+    assert_refusal, entry_names, finish, model, read_manifest, unfold_command, Run,
+};
 
 fn run_in(dir: &Path, args: &[&str]) -> Run {
     finish(unfold_command().current_dir(dir).args(args))
@@ -29,12 +31,7 @@ fn sandbox() -> (TempDir, String) {
 }
 
 fn entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
+    entry_names(dir).into_iter().collect()
 }
 
 #[test]
