@@ -40,6 +40,13 @@ fn tree(root: &Path) -> BTreeMap<PathBuf, Vec<u8>> {
     found
 }
 
+/// Every entry of `kept` is in `after` with the same bytes.
+fn assert_kept(kept: &BTreeMap<PathBuf, Vec<u8>>, after: &BTreeMap<PathBuf, Vec<u8>>) {
+    for (path, bytes) in kept {
+        assert_eq!(after.get(path), Some(bytes), "{} changed", path.display());
+    }
+}
+
 /// Names of the entries directly in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {
     entry_names(dir).into_iter().collect()
@@ -178,10 +185,7 @@ fn force_keeps_every_foreign_file() {
     let model = dir.join("tetrahedron.obj");
     let run = build(&model, &dir, &["--force", "--format", "svg,dxf"]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let after = tree(&dir);
-    for (path, bytes) in &foreign {
-        assert_eq!(after.get(path), Some(bytes), "{} changed", path.display());
-    }
+    assert_kept(&foreign, &tree(&dir));
     let first_output: Vec<String> = names(&dir)
         .into_iter()
         .filter(|n| !foreign.contains_key(Path::new(n)))
@@ -192,10 +196,7 @@ fn force_keeps_every_foreign_file() {
     // Again with SVG only: the earlier run's DXF files go, every foreign file stays.
     let run = build(&model, &dir, &["--force"]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
-    let after = tree(&dir);
-    for (path, bytes) in &foreign {
-        assert_eq!(after.get(path), Some(bytes), "{} changed", path.display());
-    }
+    assert_kept(&foreign, &tree(&dir));
     assert!(
         names(&dir).iter().all(|n| !n.ends_with(".dxf")),
         "{:?}",
@@ -269,10 +270,7 @@ fn the_home_folder_is_never_emptied() {
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     assert!(home.path().join("build/manifest.json").is_file());
     assert!(!home.path().join("~").exists());
-    let after = tree(home.path());
-    for (path, bytes) in &before {
-        assert_eq!(after.get(path), Some(bytes), "{} changed", path.display());
-    }
+    assert_kept(&before, &tree(home.path()));
 }
 
 #[test]
