@@ -1,7 +1,7 @@
 //! Load → flatten at scale: reads a model, prepares it, builds the scheme's panels and
 //! unrolls them, printing the time of each stage and the peak memory, without nesting
-//! or writing sheets (a million panels would fill thousands of sheets). For issue 8's
-//! scale figures:
+//! or writing sheets (a million panels would fill thousands of sheets). For the
+//! scale figures in docs/benchmarks.md:
 //!
 //! ```text
 //! cargo run --release --example large_torus -- 1000 1000 target/torus-1M.obj

@@ -1128,7 +1128,7 @@ mod tests {
         }
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
         // What a panel costs beside its items, against an owned panel's struct (the
-        // README's figures).
+        // figures in docs/architecture.md).
         assert_eq!(std::mem::size_of::<PanelHead>(), 56);
         assert_eq!(std::mem::size_of::<FlatHead>(), 56);
         assert_eq!(std::mem::size_of::<Panel>(), 160);

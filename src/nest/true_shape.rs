@@ -217,7 +217,7 @@ pub fn true_shape_layout(
     let (parts, container) = prepare(outlines, sheet, options)?;
     // Two constructions, each improved on its own, and the better kept: rows of
     // interlocking parts win on alike parts and long strips, first-fit decreasing on
-    // short wavy strips (README, "Nesting", has the measured cases). Each has its own
+    // short wavy strips (docs/nesting.md has the measured cases). Each has its own
     // generator from the same seed, so the result does not depend on which finishes
     // first.
     //
