@@ -111,9 +111,9 @@ fn every_sheet_passes_the_independent_check() {
 }
 
 /// The same on the big shared models (a separate test so that it runs beside the
-/// project models). At the least search effort: this checks the sheets, not how
-/// tightly they are packed (`tests/nesting.rs` and the bench do), and it keeps the
-/// suite quick.
+/// project models). Laid out by the shelf nester: this checks the panels and the
+/// sheets, not how tightly they are packed (`tests/nesting.rs` and the bench check the
+/// true-shape layout of such models), and it keeps the suite quick.
 #[test]
 fn every_sheet_of_the_shared_models_passes_the_independent_check() {
     let test = "every_sheet_of_the_shared_models_passes_the_independent_check";
@@ -123,7 +123,7 @@ fn every_sheet_of_the_shared_models_passes_the_independent_check() {
                 &shared.join(name),
                 "4ft",
                 DxfCheck::FirstAndLast,
-                &["--effort", "1"],
+                &["--nester", "shelf"],
             );
         }
     }

@@ -1084,9 +1084,9 @@ fn shared_models_have_a_panel_per_edge_and_paired_holes() {
         let (m, report, p, job) = check_model(
             &path,
             "4ft",
-            // The least search effort: the sheets are checked, not how tight they
+            // Shelf layout: the panels and sheets are checked, not how tight they
             // are (that is the nesting tests' and the bench's job).
-            &["--hole-diameter", "1mm", "--effort", "1"],
+            &["--hole-diameter", "1mm", "--nester", "shelf"],
             DxfCheck::FirstAndLast,
             false,
         );

@@ -51,7 +51,14 @@ fn a_panel_per_edge_and_every_sheet_checks_for_every_shift() {
             let edges = count(&m, "input.edges");
             assert_eq!(count(&m, "counts.panels"), edges, "{what}: panels = E");
             assert_eq!(count(&m, "counts.connections"), 2 * edges, "{what}: 2E");
-            check_output(&model(name), &out, &m, &what, DxfCheck::All, |p| {
+            // The DXF writer does not depend on the shift: ezdxf (seconds per sheet)
+            // reads the sheets of one shift per model.
+            let dxf = if shift == "0" {
+                DxfCheck::All
+            } else {
+                DxfCheck::Skip
+            };
+            check_output(&model(name), &out, &m, &what, dxf, |p| {
                 format!("E{}", p["source"]["edge"])
             });
             let max = m["max_developability_error"].as_f64().unwrap();
