@@ -8,18 +8,17 @@ use std::path::{Path, PathBuf};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use glam::DVec2;
 
-use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
+use unfold::config::{BuildOptions, Job, ModelOptions};
 use unfold::export::{draw_sheet, svg};
 use unfold::flatten::unroll_and_fit;
 use unfold::labels::LabelOptions;
 use unfold::mesh::Mesh;
 use unfold::nest::{lay_out, NestSettings, NesterName, SheetSpec};
 use unfold::panel::{FlatPanel, FlatPanels};
-use unfold::scheme::build_panels;
 
-fn job(model: &Path, scheme: SchemeName, size: &str) -> Job {
+fn job(model: &Path, scheme: &str, size: &str) -> Job {
     BuildOptions {
-        scheme: Some(scheme),
+        scheme: Some(scheme.to_string()),
         model: ModelOptions {
             size: Some(size.into()),
             ..Default::default()
@@ -39,7 +38,7 @@ fn scheme_mesh(job: &Job) -> Mesh {
 }
 
 fn flat_panels(job: &Job, mesh: &Mesh) -> Vec<FlatPanel> {
-    let output = build_panels(job.scheme, mesh, &job.scheme_options).expect("scheme");
+    let output = job.scheme.build(mesh).expect("scheme");
     output
         .panels
         .iter()
@@ -71,16 +70,11 @@ fn schemes_and_flatten(c: &mut Criterion) {
     let mut scheme_group = c.benchmark_group("scheme");
     scheme_group.sample_size(10);
     for (name, path, size) in models() {
-        for scheme in [
-            SchemeName::HalfEdge,
-            SchemeName::QuadEdge,
-            SchemeName::WingedEdge,
-            SchemeName::Woven,
-        ] {
+        for scheme in ["half-edge", "quad-edge", "winged-edge", "woven"] {
             let job = job(&path, scheme, size);
             let mesh = scheme_mesh(&job);
             scheme_group.bench_function(BenchmarkId::new(scheme.to_string(), &name), |b| {
-                b.iter(|| build_panels(job.scheme, &mesh, &job.scheme_options).unwrap())
+                b.iter(|| job.scheme.build(&mesh).unwrap())
             });
         }
     }
@@ -89,10 +83,10 @@ fn schemes_and_flatten(c: &mut Criterion) {
     let mut flatten_group = c.benchmark_group("flatten+labels");
     flatten_group.sample_size(10);
     for (name, path, size) in models() {
-        for scheme in [SchemeName::HalfEdge, SchemeName::QuadEdge] {
+        for scheme in ["half-edge", "quad-edge"] {
             let job = job(&path, scheme, size);
             let mesh = scheme_mesh(&job);
-            let output = build_panels(job.scheme, &mesh, &job.scheme_options).unwrap();
+            let output = job.scheme.build(&mesh).unwrap();
             flatten_group.bench_function(BenchmarkId::new(scheme.to_string(), &name), |b| {
                 b.iter(|| {
                     for p in &output.panels {
@@ -110,7 +104,7 @@ fn nesting_and_export(c: &mut Criterion) {
     group.sample_size(10);
     let mut drawn = Vec::new();
     for (name, path, size) in models() {
-        let job = job(&path, SchemeName::HalfEdge, size);
+        let job = job(&path, "half-edge", size);
         let flat = flat_panels(&job, &scheme_mesh(&job));
         // The largest 400 panels: a job of a few sheets, so a sample takes seconds.
         let mut by_area: Vec<&FlatPanel> = flat.iter().collect();

@@ -11,7 +11,7 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use unfold::config::{BuildOptions, ModelOptions, SchemeName};
+use unfold::config::{BuildOptions, ModelOptions};
 use unfold::flatten::unroll_all;
 use unfold::labels::LabelOptions;
 
@@ -20,13 +20,13 @@ fn main() -> anyhow::Result<()> {
     let usage = "usage: scale MODEL [half-edge|quad-edge|winged-edge]";
     let model = PathBuf::from(args.get(1).expect(usage));
     let scheme = match args.get(2).map(String::as_str) {
-        None | Some("half-edge") => SchemeName::HalfEdge,
-        Some("quad-edge") => SchemeName::QuadEdge,
-        Some("winged-edge") => SchemeName::WingedEdge,
+        None | Some("half-edge") => "half-edge",
+        Some("quad-edge") => "quad-edge",
+        Some("winged-edge") => "winged-edge",
         Some(other) => anyhow::bail!("{usage} (not {other})"),
     };
     let job = BuildOptions {
-        scheme: Some(scheme),
+        scheme: Some(scheme.to_string()),
         model: ModelOptions {
             size: Some("4ft".into()),
             ..Default::default()
@@ -54,7 +54,7 @@ fn main() -> anyhow::Result<()> {
     let scheme_mesh = unfold::run::scheme_mesh(&job, &raw, prepared.mesh)?;
     drop(raw);
     lap("split");
-    let output = unfold::scheme::build_panels(scheme, &scheme_mesh.mesh, &job.scheme_options)?;
+    let output = job.scheme.build(&scheme_mesh.mesh)?;
     // As the pipeline does (memory.rs).
     unfold::memory::release_freed();
     lap("scheme");

@@ -9,6 +9,7 @@
 //!
 //! This crate is the library; the `unfold` binary only parses options and calls it.
 
+pub mod cli;
 pub mod config;
 pub mod error;
 pub mod export;
@@ -20,9 +21,11 @@ pub mod mesh;
 pub mod nest;
 pub mod panel;
 pub mod plane;
+pub mod record;
 pub mod run;
 pub mod sanity;
 pub mod scheme;
+pub mod units;
 
 use std::path::Path;
 
@@ -360,19 +363,19 @@ impl Inspection {
         let _ = writeln!(
             s,
             "size:        {} x {} x {} model units; built: {} x {} x {} mm ({} mm per unit)",
-            fmt_num(size[0]),
-            fmt_num(size[1]),
-            fmt_num(size[2]),
-            fmt_num(self.physical.size_mm[0]),
-            fmt_num(self.physical.size_mm[1]),
-            fmt_num(self.physical.size_mm[2]),
-            fmt_num(self.physical.mm_per_unit)
+            units::fmt_num(size[0]),
+            units::fmt_num(size[1]),
+            units::fmt_num(size[2]),
+            units::fmt_num(self.physical.size_mm[0]),
+            units::fmt_num(self.physical.size_mm[1]),
+            units::fmt_num(self.physical.size_mm[2]),
+            units::fmt_num(self.physical.mm_per_unit)
         );
         let _ = writeln!(
             s,
             "area:        {} square model units; built: {} m²",
-            fmt_num(g.surface_area),
-            fmt_num(self.physical.surface_area_mm2 / 1e6)
+            units::fmt_num(g.surface_area),
+            units::fmt_num(self.physical.surface_area_mm2 / 1e6)
         );
         let _ = writeln!(
             s,
@@ -389,8 +392,8 @@ impl Inspection {
                 r.max_error_before,
                 r.max_error_after,
                 r.iterations,
-                short_number(r.max_displacement),
-                short_number(r.max_displacement / self.physical.mm_per_unit)
+                units::short_number(r.max_displacement),
+                units::short_number(r.max_displacement / self.physical.mm_per_unit)
             );
         }
         let p = &self.preparation;
@@ -420,26 +423,5 @@ impl Inspection {
             }
         }
         s
-    }
-}
-
-/// A number for a message: [`fmt_num`] when moderate, exponent form when huge or tiny
-/// (f64's `{}` would print 1e300 with 301 digits).
-pub(crate) fn short_number(x: f64) -> String {
-    if x != 0.0 && !(1e-3..1e6).contains(&x.abs()) {
-        format!("{x:.3e}")
-    } else {
-        fmt_num(x)
-    }
-}
-
-/// A number with at most 4 decimals, trailing zeros trimmed (for reports).
-fn fmt_num(x: f64) -> String {
-    let s = format!("{x:.4}");
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    if s == "-0" {
-        "0".to_string()
-    } else {
-        s.to_string()
     }
 }

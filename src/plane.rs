@@ -171,6 +171,50 @@ pub fn polygons_touch(p: &[DVec2], q: &[DVec2]) -> bool {
     contains(p, q[0]) || contains(q, p[0])
 }
 
+/// A part's chosen rotation and bounding box at that rotation.
+#[derive(Clone, Copy, Debug)]
+pub struct Oriented {
+    /// Rotation (radians counter-clockwise).
+    pub rotation: f64,
+    /// Lower-left corner of the rotated outline's bounding box.
+    pub lo: DVec2,
+    /// Its width and height.
+    pub size: DVec2,
+}
+
+/// The smallest bounding box of an outline among `steps` rotations (width, height).
+pub fn smallest_box(outline: &[DVec2], steps: u32) -> DVec2 {
+    orient(outline, steps, f64::INFINITY, f64::INFINITY).map_or(DVec2::ZERO, |o| o.size)
+}
+
+/// True when the outline's bounding box fits `max_w` × `max_h` in one of `steps`
+/// rotations.
+pub fn fits_rotated(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> bool {
+    orient(outline, steps, max_w, max_h).is_some()
+}
+
+/// The rotation (among `steps` equal steps) with the smallest bounding box that fits
+/// `max_w` × `max_h`, turned to lie flat when that also fits.
+pub fn orient(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> Option<Oriented> {
+    let steps = steps.max(1);
+    let mut best: Option<(f64, Oriented)> = None;
+    for k in 0..steps {
+        let rotation = std::f64::consts::TAU * k as f64 / steps as f64;
+        let turn = DVec2::from_angle(rotation);
+        let (lo, hi) = bounds(outline.iter().map(|&p| turn.rotate(p)));
+        let size = hi - lo;
+        if size.x > max_w || size.y > max_h {
+            continue;
+        }
+        // Smallest area first; among equals prefer flat (wide) boxes.
+        let score = size.x * size.y + if size.y > size.x { 1e-9 } else { 0.0 };
+        if best.is_none_or(|(b, _)| score < b - 1e-12) {
+            best = Some((score, Oriented { rotation, lo, size }));
+        }
+    }
+    best.map(|(_, o)| o)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,7 +12,7 @@ use crate::config::{Job, NonPlanar};
 use crate::error::{Error, InputError, Result};
 use crate::export::folder::{check_output_folder, MANIFEST};
 use crate::export::manifest::{self, round4, Manifest};
-use crate::export::{draw_sheet, dxf::DxfSheet, obj::assembled_obj, svg, Lengths};
+use crate::export::{draw_sheet, obj::assembled_obj, Lengths};
 use crate::flatten::unroll_all;
 use crate::labels::{LabelOptions, LeftOut};
 use crate::mesh::planarize::{planarize, PlanarizeOptions, PlanarizeReport};
@@ -22,7 +22,6 @@ use crate::mesh::FaceId;
 use crate::nest::{lay_out, Layout, SheetSpec};
 use crate::panel::{FlatPanelRef, FlatPanels, Source};
 use crate::plane::is_simple;
-use crate::scheme::build_panels;
 
 /// What a finished run produced.
 #[derive(Clone, Debug)]
@@ -33,6 +32,8 @@ pub struct Outcome {
     pub files: Vec<String>,
     /// Observations for the report (repairs, shortened tabs, split faces…).
     pub notes: Vec<String>,
+    /// The scheme's own report lines (the woven cycles).
+    pub scheme_report: Vec<String>,
     /// Wall time per stage.
     pub times: Vec<(&'static str, Duration)>,
 }
@@ -105,7 +106,7 @@ pub fn scheme_mesh(
     let split = faces_to_split(
         &mesh,
         job.model.planarity_tol,
-        crate::scheme::needs_convex_faces(job.scheme),
+        job.scheme.scheme.needs_convex_faces(),
     );
     if job.nonplanar == NonPlanar::Error && !split.non_planar.is_empty() {
         let worst = FaceId(split.non_planar[0]);
@@ -209,7 +210,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let topology = mesh.topology();
     clock.lap("split");
 
-    let output = build_panels(job.scheme, &mesh, &job.scheme_options).map_err(|e| {
+    let output = job.scheme.build(&mesh).map_err(|e| {
         let message = format!("{}: {e}", job.model_path.display());
         if e.is_usage() {
             Error::Usage(message)
@@ -297,21 +298,16 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         .into_par_iter()
         .map(|index| {
             let stem = format!("{name}-{:0digits$}", index + 1);
-            let mut sheet_files = Vec::new();
-            if job.formats.svg {
-                let style = svg::SvgStyle {
-                    stroke_width: job.stroke_width,
-                    ..svg::SvgStyle::default()
-                };
-                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
-                draw_sheet(&layout, index, &flat, &mut sink);
-                sheet_files.push((format!("{stem}.svg"), sink.finish().into_bytes()));
-            }
-            if job.formats.dxf {
-                let mut sink = DxfSheet::new(sheet.width, sheet.height);
-                draw_sheet(&layout, index, &flat, &mut sink);
-                sheet_files.push((format!("{stem}.dxf"), sink.finish().into_bytes()));
-            }
+            let sheet_files: Vec<(String, Vec<u8>)> = job
+                .formats
+                .iter()
+                .map(|format| {
+                    (
+                        format!("{stem}.{}", format.extension()),
+                        format.write_sheet(&layout, index, &flat, job.stroke_width),
+                    )
+                })
+                .collect();
             let mut lengths = Lengths::default();
             draw_sheet(&layout, index, &flat, &mut lengths);
             let on_sheet: Vec<FlatPanelRef> = layout
@@ -323,7 +319,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             let area: f64 = on_sheet.iter().map(|p| p.area).sum();
             let entry = manifest::SheetEntry {
                 sheet: index + 1,
-                file: format!("{stem}.svg"),
+                files: sheet_files.iter().map(|(n, _)| n.clone()).collect(),
                 panels: on_sheet.len(),
                 fill: round4(area / (sheet.width * sheet.height)),
             };
@@ -380,6 +376,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         manifest,
         files: files.into_iter().map(|(n, _)| n).collect(),
         notes,
+        scheme_report: output.report,
         times: clock.times,
     })
 }
@@ -400,7 +397,6 @@ fn build_manifest(
     nesting: manifest::Nesting,
     spacing_bound: usize,
 ) -> Manifest {
-    let o = &job.scheme_options;
     let sheet = &layout.sheet;
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
@@ -446,22 +442,11 @@ fn build_manifest(
             },
         },
         scheme: manifest::Scheme {
-            name: job.scheme.to_string(),
-            params: manifest::SchemeParams {
-                face_scale: o.face_scale,
-                bridge_scale: o.bridge_scale,
-                flap_scale: o.flap_scale,
-                samples: o.samples,
-                shift: o.shift,
-                connectors: if o.tabs { "tab" } else { "none" },
-                tab_height: round4(o.tab_height),
-                holes: o.holes,
-                hole_diameter: round4(o.hole_diameter),
-                label_height: round4(o.label_height),
-                band_scale: o.band_scale,
-                thickness: round4(o.thickness),
-                curl_limit: o.curl_limit,
-                mm_per_model_unit: mm_per_unit,
+            name: job.scheme.name().to_string(),
+            params: {
+                let mut params = job.scheme.params();
+                params.push("mm_per_model_unit", mm_per_unit);
+                params
             },
         },
         units: "mm",
@@ -480,7 +465,6 @@ fn build_manifest(
             sheets_spacing_bound: spacing_bound,
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
-            cycles: output.cycles.len(),
             labels_left_out: labels_left_out.total(),
             panel_ids_left_out: labels_left_out.panel,
             partner_ids_left_out: labels_left_out.partner,
@@ -493,16 +477,7 @@ fn build_manifest(
             score: round4(lengths.score),
             engrave: round4(lengths.engrave),
         },
-        cycles: output
-            .cycles
-            .iter()
-            .map(|c| manifest::CycleEntry {
-                id: format!("C{}", c.id),
-                edges: c.edges,
-                length: round4(c.length),
-                segments: c.segments,
-            })
-            .collect(),
+        scheme_sections: output.manifest.clone(),
         max_developability_error: manifest::round_nm(
             flat.iter()
                 .map(|p| p.developability_error)
@@ -545,17 +520,8 @@ pub fn report_text(outcome: &Outcome, out: &Path) -> String {
         100.0 * m.utilization,
         c.sheets_spacing_bound
     );
-    if !m.cycles.is_empty() {
-        let edges = m.cycles.iter().map(|y| y.edges);
-        let (lo, hi) = (edges.clone().min().unwrap_or(0), edges.max().unwrap_or(0));
-        let length: f64 = m.cycles.iter().map(|y| y.length).sum();
-        let segments: usize = m.cycles.iter().map(|y| y.segments).sum();
-        let _ = writeln!(
-            s,
-            "weave: {} cycles of {lo} to {hi} edges, {:.0} mm of ribbon in all, cut into {segments} segments",
-            m.cycles.len(),
-            length
-        );
+    for line in &outcome.scheme_report {
+        let _ = writeln!(s, "{line}");
     }
     let fills: Vec<String> = m
         .sheets

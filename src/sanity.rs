@@ -115,7 +115,7 @@ fn strict(job: &Job, warnings: &[String]) -> Result<()> {
 }
 
 /// Checks, after the labels were fitted and before the nest, that the panels carry
-/// their ids: more than [`IDS_LEFT_OUT`] of them left out means the model is too
+/// their ids: more than `IDS_LEFT_OUT` of them left out means the model is too
 /// detailed for its size. The warning gives the budget (and the size) at which the
 /// scheme's panels carry them. With `--strict` it is a refusal.
 pub fn check_labels(
@@ -172,7 +172,7 @@ fn too_detailed(
     };
     format!(
         "the model is too detailed for its size: {} of {panels} {} panels have no room for their id and {} partner ids are left out; {fix}",
-        left_out.panel, job.scheme, left_out.partner
+        left_out.panel, job.scheme.name(), left_out.partner
     )
 }
 
@@ -196,8 +196,7 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let labels_fit = |length: f64| -> bool {
         let mut scaled = probe.clone();
         scaled.scale(length / edge);
-        let Ok(output) = crate::scheme::build_panels(job.scheme, &scaled, &job.scheme_options)
-        else {
+        let Ok(output) = job.scheme.build(&scaled) else {
             return false;
         };
         crate::flatten::unroll_all(&output.panels, LabelOptions::default())

@@ -713,16 +713,24 @@ const ABSURD_OPTIONS: &[OptionCase] = &[
         &["--face-scale: 2 must be greater than 0 and at most 1"],
     ),
     (
-        &["--samples", "1000000000"],
-        &["--samples: 1000000000 must be between 1 and 64"],
+        &["--samples", "8"],
+        &["--samples: the half-edge scheme does not take this option; it is an option of quad-edge, winged-edge, chosen with --scheme"],
     ),
     (
         &["--scheme", "quad-edge", "--samples", "1000000000"],
         &["--samples: 1000000000 must be between 1 and 64"],
     ),
     (
-        &["--samples", "0"],
+        &["--scheme", "winged-edge", "--samples", "0"],
         &["--samples: 0 must be between 1 and 64"],
+    ),
+    (
+        &["--scheme", "winged-edge", "--shift", "2"],
+        &["--shift: 2 must be -1, 0 or 1"],
+    ),
+    (
+        &["--scheme", "woven", "--curl-limit", "1"],
+        &["--curl-limit: 1 must be at least 1.5"],
     ),
     (&["--size", "0mm"], &["--size: '0mm' must be positive"]),
     (
@@ -746,7 +754,7 @@ const ABSURD_OPTIONS: &[OptionCase] = &[
         &["--label-height: '-1mm' must be positive"],
     ),
     (
-        &["--bridge-scale", "2"],
+        &["--scheme", "quad-edge", "--bridge-scale", "2"],
         &["--bridge-scale: 2 must be greater than 0 and at most 1"],
     ),
     (

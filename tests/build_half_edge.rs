@@ -27,7 +27,7 @@ use common::build::{
     folder_files, frames_of, golden_build, inside, inspect_json, model, num, obj_face_count,
     panels_of, read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck,
 };
-use unfold::config::{Job, SchemeName};
+use unfold::config::Job;
 use unfold::mesh::EdgeId;
 use unfold::panel::{LabelKind, Source};
 
@@ -52,7 +52,7 @@ fn polygon_area_3d(points: &[DVec3]) -> f64 {
 }
 
 fn half_edge_job(model: &Path, size: &str, holes: u32, out: &Path) -> Job {
-    common::build::job(SchemeName::HalfEdge, model, size, holes, out)
+    common::build::job("half-edge", model, size, holes, out)
 }
 
 // =======================================================================================
@@ -283,7 +283,7 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
     let (mesh, connections, panels, flat) = panels_of(&job);
     let frames = frames_of(&panels);
     let tol = rel_tol * size_mm;
-    let r = 0.5 * job.scheme_options.hole_diameter;
+    let r = 0.5 * job.scheme.panel().hole_diameter;
 
     // How far a facet's 3D corners are from the plane of its frame: 0 (rounding) for
     // planar faces; faces planar only within --planarity-tol are kept as one facet,

@@ -31,9 +31,10 @@ use common::build::{
     Pipeline, Run,
 };
 use common::svg_circles;
-use unfold::config::{BuildOptions, Job, SchemeName};
+use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
 use unfold::panel::{FlatPanel, Panel, Source};
+use unfold::scheme::edge_panel::EdgeOptions;
 
 // =======================================================================================
 // Helpers
@@ -47,7 +48,7 @@ fn build_run(model: &Path, size: &str, out: &Path, extra: &[&str]) -> (Value, Ru
 
 /// Build options of the quad-edge scheme, to adjust before `resolve`.
 fn quad_options(size: &str, holes: u32, out: &Path) -> BuildOptions {
-    common::build::options(SchemeName::QuadEdge, size, holes, out)
+    common::build::options("quad-edge", size, holes, out)
 }
 
 /// The library-level twin of `unfold MODEL --scheme quad-edge --size SIZE --holes H
@@ -61,8 +62,17 @@ fn quad_job(
 ) -> Job {
     let mut options = quad_options(size, holes, Path::new("unused"));
     options.hole_diameter = hole_diameter.map(str::to_string);
-    options.samples = samples;
+    if let Some(n) = samples {
+        options.scheme_values.set("samples", &n.to_string());
+    }
     resolve(options, model)
+}
+
+/// The quad-edge job's own options.
+fn edge_options(job: &Job) -> &EdgeOptions {
+    job.scheme
+        .options_as::<EdgeOptions>()
+        .expect("quad-edge options")
 }
 
 /// Σ face degrees of a mesh (its face corners).
@@ -213,7 +223,7 @@ fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
 /// itself.
 fn check_panels(p: &Pipeline, job: &Job, what: &str) {
     let mesh = &p.mesh;
-    let n = job.scheme_options.samples as usize;
+    let n = edge_options(job).samples as usize;
     assert_eq!(
         p.flat.len(),
         mesh.edge_count(),
@@ -311,7 +321,7 @@ fn check_developable(p: &Pipeline, what: &str, rel: f64) -> f64 {
 /// band edge.
 fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) {
     let mesh = &p.mesh;
-    let o = &job.scheme_options;
+    let o = edge_options(job);
     let n = o.samples as usize;
     let tol = 1e-9 * size_mm;
     // Bends are exact between planar faces. Between faces planar only within
@@ -337,7 +347,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
             flaps.push((mesh.face(h).unwrap(), h, 0));
         } else {
             let (f, g) = (mesh.face(h).unwrap(), mesh.face(h.twin()).unwrap());
-            let s = o.face_scale;
+            let s = o.panel.face_scale;
             let b = o.bridge_scale;
             let m = 0.5 * (v + w);
             let rail = |t: f64| {
@@ -448,15 +458,20 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
             let nrm = normal(mesh, face);
             let band: Vec<DVec3> = mesh
                 .face_positions(face)
-                .map(|p| band_corner(mesh, face, p, o.face_scale))
+                .map(|p| band_corner(mesh, face, p, o.panel.face_scale))
                 .collect();
             let ex = (band[1] - band[0]).normalize();
             let ey = nrm.cross(ex);
             let to2 = |p: DVec3| DVec2::new((p - c).dot(ex), (p - c).dot(ey));
             let band2: Vec<DVec2> = band.iter().map(|&p| to2(p)).collect();
             let (bv, bw) = (
-                band_corner(mesh, face, mesh.position(mesh.origin(he)), o.face_scale),
-                band_corner(mesh, face, mesh.position(mesh.dest(he)), o.face_scale),
+                band_corner(
+                    mesh,
+                    face,
+                    mesh.position(mesh.origin(he)),
+                    o.panel.face_scale,
+                ),
+                band_corner(mesh, face, mesh.position(mesh.dest(he)), o.panel.face_scale),
             );
             let lerp = |p: DVec3| p + o.flap_scale * (c - p);
             let (iv, iw) = (to2(lerp(bv)), to2(lerp(bw)));
@@ -540,9 +555,9 @@ fn check_holes(
     all: bool,
 ) -> HoleFacts {
     let mesh = &p.mesh;
-    let o = &job.scheme_options;
-    let wanted = o.holes as usize;
-    let d = o.hole_diameter;
+    let o = edge_options(job);
+    let wanted = o.panel.holes as usize;
+    let d = o.panel.hole_diameter;
     let r = 0.5 * d;
     let tol = rel_tol * size_mm;
     let n = o.samples as usize;
@@ -721,7 +736,7 @@ fn check_holes(
         let to2 = |q: DVec3| DVec2::new((q - cf).dot(ex), (q - cf).dot(ey));
         let band: Vec<DVec2> = mesh
             .face_positions(f)
-            .map(|v| to2(band_corner(mesh, f, v, o.face_scale)))
+            .map(|v| to2(band_corner(mesh, f, v, o.panel.face_scale)))
             .collect();
         // Signed distance from the inner line of the band edge of half-edge `g`,
         // positive on the band edge's side.
@@ -731,13 +746,13 @@ fn check_holes(
                     mesh,
                     f,
                     mesh.position(mesh.origin(g)),
-                    o.face_scale,
+                    o.panel.face_scale,
                 )),
                 to2(band_corner(
                     mesh,
                     f,
                     mesh.position(mesh.dest(g)),
-                    o.face_scale,
+                    o.panel.face_scale,
                 )),
             );
             let (iv, iw) = (bv * (1.0 - o.flap_scale), bw * (1.0 - o.flap_scale));
@@ -838,7 +853,7 @@ fn check_holes_in_files(
 ) {
     let tmp = TempDir::new().unwrap();
     let out = tmp.path().join("out");
-    let holes = job.scheme_options.holes.to_string();
+    let holes = job.scheme.panel().holes.to_string();
     let mut args = vec!["--holes", &holes, "--format", "svg"];
     args.extend_from_slice(extra);
     let (m, run) = build_run(model, size, &out, &args);
@@ -858,7 +873,7 @@ fn check_holes_in_files(
         facts.holes,
         "{what}: circles on the sheets"
     );
-    let r = 0.5 * job.scheme_options.hole_diameter;
+    let r = 0.5 * job.scheme.panel().hole_diameter;
     for file in &sheets.svg_files {
         let text = std::fs::read_to_string(out.join(file)).unwrap();
         for (layer, _, _, radius) in svg_circles(&text) {
@@ -880,7 +895,7 @@ fn check_holes_in_files(
             (
                 facts.fewer,
                 p.output.connections,
-                job.scheme_options.holes as usize,
+                job.scheme.panel().holes as usize,
                 facts.none
             ),
             "{what}: the report's note on holes: {}",

@@ -19,12 +19,11 @@ use common::build::{
     build, check_output, check_sheets, count, frames_of, golden_build, model, options, pipeline,
     resolve, DxfCheck,
 };
-use unfold::config::SchemeName;
 
 /// The winged-edge job for a project model.
 fn winged_job(name: &str, size: &str, holes: u32, shift: i32, out: &Path) -> unfold::Job {
-    let mut o = options(SchemeName::WingedEdge, size, holes, out);
-    o.shift = Some(shift);
+    let mut o = options("winged-edge", size, holes, out);
+    o.scheme_values.set("shift", &shift.to_string());
     resolve(o, &model(name))
 }
 

@@ -329,6 +329,11 @@ fn an_older_manifest_does_not_make_the_users_dxf_files_ours() {
     let mut manifest: serde_json::Value =
         serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
     manifest.as_object_mut().unwrap().remove("files");
+    for sheet in manifest["sheets"].as_array_mut().unwrap() {
+        let sheet = sheet.as_object_mut().unwrap();
+        let svg = sheet.remove("files").unwrap()[0].clone();
+        sheet.insert("file".into(), svg);
+    }
     std::fs::write(&path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
     std::fs::write(out.join("tetrahedron-01.dxf"), "my own drawing\n").unwrap();
     let before = tree(tmp.path());

@@ -12,12 +12,12 @@ use tempfile::TempDir;
 use common::build::{
     build_run, check_sheets, inspect_json, model, options, shared_models, DxfCheck,
 };
-use unfold::config::{Job, NonPlanar, SchemeName};
+use unfold::config::{Job, NonPlanar};
 use unfold::mesh::geometry::planarity_error;
 use unfold::run::{scheme_mesh, SchemeMesh};
 
 fn job(model: &Path, nonplanar: NonPlanar, out: &Path) -> Job {
-    let mut options = options(SchemeName::HalfEdge, "4ft", 0, out);
+    let mut options = options("half-edge", "4ft", 0, out);
     options.nonplanar = Some(nonplanar);
     options.resolve(model).expect("options resolve")
 }

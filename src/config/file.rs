@@ -8,14 +8,15 @@ use std::any::TypeId;
 use std::ops::Range;
 use std::path::Path;
 
-use clap::Args;
 use toml::de::{DeTable, DeValue};
 
 use super::{parse_length, parse_sheet, BuildOptions, ModelOptions};
 use crate::error::{Error, Result};
+use crate::scheme::{OptionValues, Registry};
 
-/// Reads a configuration file into options (every key optional).
-pub fn load_config(path: &Path) -> Result<BuildOptions> {
+/// Reads a configuration file into options (every key optional); the schemes' own
+/// keys are those of `registry`.
+pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::Usage(format!("--config {}: cannot read it: {e}", path.display())))?;
     let at = |span: Option<Range<usize>>, what: String| {
@@ -34,7 +35,13 @@ pub fn load_config(path: &Path) -> Result<BuildOptions> {
             format!("not valid TOML: {}", one_line(e.message())),
         )
     })?;
-    let options = options();
+    let options = options(registry);
+    let scheme_keys: Vec<String> = registry
+        .options()
+        .iter()
+        .filter_map(|a| a.get_long().map(str::to_string))
+        .collect();
+    let mut scheme_values = OptionValues::default();
     // In file order, so the first mistake reported is the first in the file.
     let mut entries: Vec<_> = table.get_ref().iter().collect();
     entries.sort_by_key(|(key, _)| key.span().start);
@@ -49,6 +56,15 @@ pub fn load_config(path: &Path) -> Result<BuildOptions> {
                 format!("{name} = {}: {why}", shown(&text, value.span())),
             )
         })?;
+        if scheme_keys.iter().any(|k| k == name) {
+            let raw = text.get(value.span()).unwrap_or("").trim();
+            let as_text = match value.get_ref() {
+                DeValue::String(s) => s.to_string(),
+                DeValue::Boolean(b) => b.to_string(),
+                _ => raw.replace('_', ""),
+            };
+            scheme_values.set_from_file(name, &as_text);
+        }
     }
     // Every key and value was checked above; what remains are errors of the
     // deserializer itself, still placed by their span.
@@ -56,7 +72,11 @@ pub fn load_config(path: &Path) -> Result<BuildOptions> {
         toml::from_str(&text).map_err(|e| at(e.span(), one_line(e.message())))?;
     let model: ModelOptions =
         toml::from_str(&text).map_err(|e| at(e.span(), one_line(e.message())))?;
-    Ok(BuildOptions { model, ..build })
+    Ok(BuildOptions {
+        model,
+        scheme_values,
+        ..build
+    })
 }
 
 /// What values an option takes.
@@ -86,8 +106,8 @@ struct ConfigOption {
 }
 
 /// Every config key, read off the command line's own definitions.
-fn options() -> Vec<ConfigOption> {
-    let command = BuildOptions::augment_args(clap::Command::new("unfold"));
+fn options(registry: &Registry) -> Vec<ConfigOption> {
+    let command = BuildOptions::command(registry);
     command
         .get_arguments()
         .filter_map(|arg| {
@@ -277,7 +297,7 @@ mod tests {
 
     #[test]
     fn every_option_is_a_key_and_kinds_follow_the_options() {
-        let options = options();
+        let options = options(&Registry::default());
         let kind = |key: &str| {
             options
                 .iter()

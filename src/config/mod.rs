@@ -5,117 +5,19 @@
 
 use crate::nest::true_shape::NestOptions;
 use crate::nest::{NestSettings, NesterName};
-use std::fmt;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
+use crate::export::Format;
+use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry};
 
 mod file;
 pub use file::load_config;
 
-/// Millimetres per inch.
-pub const MM_PER_INCH: f64 = 25.4;
-
-/// A unit of length.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum LengthUnit {
-    /// Millimetres.
-    Mm,
-    /// Centimetres.
-    Cm,
-    /// Metres.
-    M,
-    /// Inches.
-    In,
-    /// Feet.
-    Ft,
-}
-
-impl LengthUnit {
-    /// Millimetres in one unit.
-    pub fn mm(self) -> f64 {
-        match self {
-            LengthUnit::Mm => 1.0,
-            LengthUnit::Cm => 10.0,
-            LengthUnit::M => 1000.0,
-            LengthUnit::In => MM_PER_INCH,
-            LengthUnit::Ft => 12.0 * MM_PER_INCH,
-        }
-    }
-
-    fn parse_suffix(s: &str) -> Option<LengthUnit> {
-        match s.trim().to_ascii_lowercase().as_str() {
-            "mm" => Some(LengthUnit::Mm),
-            "cm" => Some(LengthUnit::Cm),
-            "m" => Some(LengthUnit::M),
-            "in" | "inch" | "inches" | "\"" => Some(LengthUnit::In),
-            "ft" | "foot" | "feet" | "'" => Some(LengthUnit::Ft),
-            _ => None,
-        }
-    }
-}
-
-/// Splits "4.5ft" into (4.5, "ft").
-fn split_number(s: &str) -> (&str, &str) {
-    let s = s.trim();
-    let end = s
-        .char_indices()
-        .find(|&(_, c)| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+' || c == 'e'))
-        .map_or(s.len(), |(i, _)| i);
-    // "1e" would swallow the 'e' of nothing; numbers here never need exponents
-    // followed by a unit starting with 'e', so trim a trailing 'e'.
-    let end = if s[..end].ends_with('e') {
-        end - 1
-    } else {
-        end
-    };
-    (&s[..end], &s[end..])
-}
-
-/// The longest length (mm) any option takes: 1 km. Far beyond any sheet or build, and
-/// small enough that areas and offsets of such lengths stay finite in f32 collision
-/// geometry.
-pub const MAX_LENGTH_MM: f64 = 1e6;
-
-/// Parses a length with its unit ("4ft", "1.2m", "48in", "0.25 in", "600mm") into
-/// millimetres. A unit is required: a bare "4" could mean feet or millimetres. Lengths
-/// beyond [`MAX_LENGTH_MM`] either way are refused.
-pub fn parse_length(text: &str) -> std::result::Result<f64, String> {
-    let mm = parse_length_unbounded(text)?;
-    if mm.abs() > MAX_LENGTH_MM {
-        return Err(format!(
-            "'{text}' is longer than 1 km, the longest length unfold takes"
-        ));
-    }
-    Ok(mm)
-}
-
-fn parse_length_unbounded(text: &str) -> std::result::Result<f64, String> {
-    let (number, unit) = split_number(text);
-    let value: f64 = number.parse().map_err(|_| {
-        format!(
-            "'{text}' is not a length; write a number and a unit, like 4ft, 1.2m, 48in or 600mm"
-        )
-    })?;
-    if unit.trim().is_empty() {
-        return Err(format!(
-            "'{text}' has no unit; write it with one, like {text}mm, {text}in or {text}ft"
-        ));
-    }
-    let unit = LengthUnit::parse_suffix(unit).ok_or_else(|| {
-        format!(
-            "'{text}' has an unknown unit '{}'; use mm, cm, m, in or ft",
-            unit.trim()
-        )
-    })?;
-    if !value.is_finite() {
-        return Err(format!("'{text}' is not a finite length"));
-    }
-    Ok(value * unit.mm())
-}
+pub use crate::units::{parse_length, LengthUnit, MAX_LENGTH_MM, MM_PER_INCH};
+use crate::units::{parse_length_unbounded, split_number};
 
 /// A sheet of material.
 #[derive(Clone, Debug, PartialEq)]
@@ -185,31 +87,6 @@ pub fn parse_sheet(text: &str) -> std::result::Result<SheetSize, String> {
         height,
         name: text.trim().to_string(),
     })
-}
-
-/// The panel schemes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "kebab-case")]
-pub enum SchemeName {
-    /// One panel per face, tabs on interior edges.
-    HalfEdge,
-    /// One panel per edge: Bézier edge bands with flaps, joined at face corners.
-    QuadEdge,
-    /// Quad-edge panels with wings along the neighbouring face edges.
-    WingedEdge,
-    /// Plain-weaving ribbons from the extended graph rotation system.
-    Woven,
-}
-
-impl fmt::Display for SchemeName {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            SchemeName::HalfEdge => "half-edge",
-            SchemeName::QuadEdge => "quad-edge",
-            SchemeName::WingedEdge => "winged-edge",
-            SchemeName::Woven => "woven",
-        })
-    }
 }
 
 /// Options that describe the model and its physical size (shared by `inspect` and the
@@ -311,18 +188,18 @@ impl ModelSettings {
         } else {
             "more than 1 km".to_string()
         };
-        let built = format!("{} mm across", crate::short_number(built_mm));
+        let built = format!("{} mm across", crate::units::short_number(built_mm));
         if scaling.scale != 1.0 {
             return Err(Error::Usage(format!(
                 "--scale: {} makes {} {built}, {bound}; use a scale nearer 1 or give --size",
-                crate::short_number(scaling.scale),
+                crate::units::short_number(scaling.scale),
                 model.display()
             )));
         }
         if let Some(size) = scaling.size {
             return Err(Error::Usage(format!(
                 "--size: {} mm is {bound}; give a size between 0.1 mm and 1 km",
-                crate::short_number(size)
+                crate::units::short_number(size)
             )));
         }
         Err(crate::error::InputError::new(
@@ -429,9 +306,10 @@ impl ModelOptions {
 #[derive(Clone, Debug, Default, Deserialize, clap::Args)]
 #[serde(rename_all = "kebab-case")]
 pub struct BuildOptions {
-    /// Panel scheme: half-edge, quad-edge, winged-edge or woven. [default: half-edge]
+    /// Panel scheme (the values and the default are the registry's; see
+    /// [`crate::scheme::Registry`]).
     #[arg(long, value_name = "SCHEME")]
-    pub scheme: Option<SchemeName>,
+    pub scheme: Option<String>,
 
     /// Sheet size: WxH with a unit (18x24in, 600x400mm) or a name (A0..A5, letter,
     /// legal, tabloid). [default: 18x24in]
@@ -463,59 +341,11 @@ pub struct BuildOptions {
     pub format: Option<String>,
 
     /// Face band scale s: each panel corner moves toward the face centre,
-    /// s·v + (1−s)·c. [default: 1 for half-edge, 0.5 for quad-edge and winged-edge,
-    /// 0.8 for woven (below 1: the crossings lie between the face bands)]
+    /// s·v + (1−s)·c. [default: set by the scheme]
     #[arg(long, value_name = "S")]
     pub face_scale: Option<f64>,
 
-    /// Strand width (woven): a strand's end covers this fraction of the face band's
-    /// side, below 1. [default: 0.4]
-    #[arg(long, value_name = "T")]
-    pub band_scale: Option<f64>,
-
-    /// Curl limit (woven): a ribbon segment's convex hull is at most this many times
-    /// its area. Smaller cuts ribbons into more, straighter segments that nest on
-    /// fewer sheets; larger gives fewer joints. [default: 3]
-    #[arg(long, value_name = "R")]
-    pub curl_limit: Option<f64>,
-
-    /// Material thickness (woven), with a unit: the two strands at a crossing are this
-    /// far apart, one lifted and one lowered by half of it; 0 for flat ribbons.
-    /// [default: 0.1in]
-    #[arg(long, value_name = "LENGTH")]
-    pub thickness: Option<String>,
-
-    /// Edge band control points (quad-edge): b·v + (1−b)·m toward the edge midpoint m;
-    /// smaller b makes the bend rounder. [default: 0.5]
-    #[arg(long, value_name = "B")]
-    pub bridge_scale: Option<f64>,
-
-    /// Flap depth (quad-edge): the flap's inner line joins the band corners moved this
-    /// fraction toward the face centre. [default: 0.5]
-    #[arg(long, value_name = "F")]
-    pub flap_scale: Option<f64>,
-
-    /// Strips of the Bézier bend (quad-edge); every ruling between two strips is a
-    /// score line. [default: 4]
-    #[arg(long, value_name = "N")]
-    pub samples: Option<u32>,
-
-    /// Winged-edge wings: 0 = a half-length wing on each side, 1 = one full-length
-    /// wing over the next edge's flap, -1 = over the previous edge's. [default: 0]
-    #[arg(long, value_name = "S", allow_negative_numbers = true)]
-    pub shift: Option<i32>,
-
-    /// Connectors on interior edges (half-edge scheme): tab or none. [default: tab]
-    #[arg(long, value_name = "KIND")]
-    pub connectors: Option<Connectors>,
-
-    /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
-    /// where the neighbour is smaller. [default: 8mm]
-    #[arg(long, value_name = "LENGTH")]
-    pub tab_height: Option<String>,
-
-    /// Fastener holes per connection: half-edge 0, 1 or 2; quad-edge 0, 1, 2 or 4.
-    /// [default: 0 for half-edge, 2 for quad-edge]
+    /// Fastener holes per connection. [default: set by the scheme]
     #[arg(long, value_name = "N")]
     pub holes: Option<u32>,
 
@@ -594,16 +424,12 @@ pub struct BuildOptions {
     #[command(flatten)]
     #[serde(skip)]
     pub model: ModelOptions,
-}
 
-/// Connector kinds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Connectors {
-    /// A glue or pin tab on one of the two panels.
-    Tab,
-    /// Nothing: panels meet edge to edge.
-    None,
+    /// The schemes' own options as given (their arguments come from the registry,
+    /// not from this type; the command line and [`load_config`] fill them in).
+    #[arg(skip)]
+    #[serde(skip)]
+    pub scheme_values: OptionValues,
 }
 
 /// What to do with non-planar faces.
@@ -618,15 +444,6 @@ pub enum NonPlanar {
     Error,
 }
 
-/// Which files to write.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct OutputFormats {
-    /// One SVG per sheet.
-    pub svg: bool,
-    /// One R12 DXF per sheet.
-    pub dxf: bool,
-}
-
 /// A fully resolved build job: every length in millimetres.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Job {
@@ -634,8 +451,8 @@ pub struct Job {
     pub model_path: PathBuf,
     /// Model options.
     pub model: ModelSettings,
-    /// Panel scheme.
-    pub scheme: SchemeName,
+    /// Panel scheme, with its options resolved (lengths in mm).
+    pub scheme: ConfiguredScheme,
     /// Sheet size.
     pub sheet: SheetSize,
     /// Sheet margin, mm.
@@ -652,10 +469,8 @@ pub struct Job {
     pub json: bool,
     /// Print nothing on stderr but errors.
     pub quiet: bool,
-    /// File formats.
-    pub formats: OutputFormats,
-    /// Scheme options (lengths in mm).
-    pub scheme_options: crate::scheme::SchemeOptions,
+    /// Sheet file formats, in the order their files are written.
+    pub formats: Vec<Format>,
     /// Non-planar face policy.
     pub nonplanar: NonPlanar,
     /// Layout settings.
@@ -665,6 +480,64 @@ pub struct Job {
 }
 
 impl BuildOptions {
+    /// Completes a command holding these options with `registry`: the `--scheme`
+    /// values and default, the per-scheme defaults in `--help`, and every scheme's own
+    /// options.
+    pub fn with_registry(command: clap::Command, registry: &Registry) -> clap::Command {
+        let schemes: Vec<clap::builder::PossibleValue> = registry
+            .schemes()
+            .iter()
+            .map(|s| clap::builder::PossibleValue::new(s.name()).help(s.about()))
+            .collect();
+        let scheme_help = format!(
+            "Panel scheme: {}. [default: {}]",
+            registry.names().join(", "),
+            registry.default_scheme().name()
+        );
+        let face_scale_help = format!(
+            "Face band scale s: each panel corner moves toward the face centre, s·v + (1−s)·c. [default: {}]",
+            registry.describe_defaults(|d| d.face_scale)
+        );
+        let holes_help = format!(
+            "Fastener holes per connection. [default: {}]",
+            registry.describe_defaults(|d| d.holes)
+        );
+        command
+            .mut_arg("scheme", |a| {
+                a.value_parser(clap::builder::PossibleValuesParser::new(schemes))
+                    .help(scheme_help)
+            })
+            .mut_arg("face_scale", |a| a.help(face_scale_help))
+            .mut_arg("holes", |a| a.help(holes_help))
+            .args(registry.options())
+    }
+
+    /// The main command's options alone, for the config file's keys.
+    pub fn command(registry: &Registry) -> clap::Command {
+        use clap::Args;
+        Self::with_registry(Self::augment_args(clap::Command::new("unfold")), registry)
+    }
+
+    /// The schemes' own options given on a command line parsed by a command from
+    /// [`BuildOptions::with_registry`].
+    pub fn scheme_values(matches: &clap::ArgMatches, registry: &Registry) -> OptionValues {
+        let mut values = OptionValues::default();
+        for arg in registry.options() {
+            let id = arg.get_id().as_str();
+            let (Some(long), Some(clap::parser::ValueSource::CommandLine)) =
+                (arg.get_long(), matches.value_source(id))
+            else {
+                continue;
+            };
+            if matches!(arg.get_action(), clap::ArgAction::SetTrue) {
+                values.set(long, "true");
+            } else if let Some(text) = matches.get_raw(id).and_then(|mut raw| raw.next_back()) {
+                values.set(long, &text.to_string_lossy());
+            }
+        }
+        values
+    }
+
     /// Fills fields missing here from `other` (the configuration file).
     pub fn or(self, other: BuildOptions) -> BuildOptions {
         BuildOptions {
@@ -676,15 +549,6 @@ impl BuildOptions {
             force: self.force || other.force,
             format: self.format.or(other.format),
             face_scale: self.face_scale.or(other.face_scale),
-            band_scale: self.band_scale.or(other.band_scale),
-            thickness: self.thickness.or(other.thickness),
-            curl_limit: self.curl_limit.or(other.curl_limit),
-            bridge_scale: self.bridge_scale.or(other.bridge_scale),
-            flap_scale: self.flap_scale.or(other.flap_scale),
-            samples: self.samples.or(other.samples),
-            shift: self.shift.or(other.shift),
-            connectors: self.connectors.or(other.connectors),
-            tab_height: self.tab_height.or(other.tab_height),
             holes: self.holes.or(other.holes),
             hole_diameter: self.hole_diameter.or(other.hole_diameter),
             label_height: self.label_height.or(other.label_height),
@@ -700,11 +564,18 @@ impl BuildOptions {
             json: self.json || other.json,
             quiet: self.quiet || other.quiet,
             model: self.model.or(other.model),
+            scheme_values: self.scheme_values.or(other.scheme_values),
         }
     }
 
-    /// Checks every value, converts units and fills in defaults.
+    /// Checks every value, converts units and fills in defaults, with the built-in
+    /// schemes.
     pub fn resolve(&self, model_path: &Path) -> Result<Job> {
+        self.resolve_with(model_path, &Registry::default())
+    }
+
+    /// [`BuildOptions::resolve`] choosing the scheme from `registry`.
+    pub fn resolve_with(&self, model_path: &Path, registry: &Registry) -> Result<Job> {
         let usage = |option: &str, e: String| Error::Usage(format!("--{option}: {e}"));
         let sheet = parse_sheet(self.sheet.as_deref().unwrap_or("18x24in"))
             .map_err(|e| usage("sheet", e))?;
@@ -726,7 +597,7 @@ impl BuildOptions {
                 sheet.height
             )));
         }
-        let formats = parse_formats(self.format.as_deref().unwrap_or("svg"))
+        let formats = Format::parse_list(self.format.as_deref().unwrap_or("svg"))
             .map_err(|e| usage("format", e))?;
         let out = match &self.out {
             Some(dir) => dir.clone(),
@@ -746,91 +617,58 @@ impl BuildOptions {
                 Err(usage(option, format!("'{text}' must be positive")))
             }
         };
-        let scheme = self.scheme.unwrap_or(SchemeName::HalfEdge);
-        let fraction = |option: &str, value: Option<f64>, default: f64| {
-            let x = value.unwrap_or(default);
-            if x > 0.0 && x <= 1.0 {
-                Ok(x)
-            } else {
-                Err(usage(
-                    option,
-                    format!("{x} must be greater than 0 and at most 1"),
-                ))
-            }
+        let scheme = match self.scheme.as_deref() {
+            None => registry.default_scheme(),
+            Some(name) => registry.get(name).ok_or_else(|| {
+                usage(
+                    "scheme",
+                    format!(
+                        "unknown scheme '{name}'; use one of {}",
+                        registry.names().join(", ")
+                    ),
+                )
+            })?,
         };
-        let face_scale = fraction(
-            "face-scale",
-            self.face_scale,
-            match scheme {
-                SchemeName::HalfEdge => 1.0,
-                SchemeName::Woven => 0.8,
-                _ => 0.5,
-            },
-        )?;
-        let band_scale = fraction("band-scale", self.band_scale, 0.4)?;
-        if scheme == SchemeName::Woven {
-            if face_scale >= 1.0 {
-                return Err(usage(
-                    "face-scale",
-                    "woven needs a face scale below 1: the strands cross in the gap between the face bands".to_string(),
-                ));
-            }
-            if band_scale >= 1.0 {
-                return Err(usage(
-                    "band-scale",
-                    "woven needs a band scale below 1: a strand's end must stay clear of the band corner".to_string(),
-                ));
-            }
-        }
-        let curl_limit = self.curl_limit.unwrap_or(3.0);
-        if !(curl_limit.is_finite() && curl_limit >= 1.5) {
+        // An option of another scheme on the command line is a mistake worth naming
+        // (a config file may serve several schemes, so its keys are not checked).
+        let own: Vec<clap::Arg> = scheme.options();
+        if let Some(name) = self
+            .scheme_values
+            .asked()
+            .find(|name| !own.iter().any(|a| a.get_long() == Some(*name)))
+        {
+            let takers: Vec<&str> = registry
+                .schemes()
+                .iter()
+                .filter(|s| s.options().iter().any(|a| a.get_long() == Some(name)))
+                .map(|s| s.name())
+                .collect();
             return Err(usage(
-                "curl-limit",
-                format!("{curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"),
+                name,
+                format!(
+                    "the {} scheme does not take this option; it is an option of {}, chosen with --scheme",
+                    scheme.name(),
+                    takers.join(", ")
+                ),
             ));
         }
-        let thickness = {
-            let text = self.thickness.as_deref().unwrap_or("0.1in");
-            let mm = parse_length(text).map_err(|e| usage("thickness", e))?;
-            // Material thicker than the sheet is wide is a typo (1e300mm would also
-            // overflow the ribbon geometry).
-            let widest = sheet.width.min(sheet.height);
-            if !(mm >= 0.0 && mm.is_finite()) {
-                return Err(usage(
-                    "thickness",
-                    format!("'{text}' must be zero or positive"),
-                ));
-            }
-            if mm >= widest {
-                return Err(usage(
-                    "thickness",
-                    format!("'{text}' is not below the sheet's shorter side ({widest:.1} mm); it is the material's thickness"),
-                ));
-            }
-            mm
-        };
-        let bridge_scale = fraction("bridge-scale", self.bridge_scale, 0.5)?;
-        let flap_scale = fraction("flap-scale", self.flap_scale, 0.5)?;
-        let samples = self.samples.unwrap_or(4);
-        if !(1..=64).contains(&samples) {
+        let defaults = scheme.defaults();
+        let face_scale = self.face_scale.unwrap_or(defaults.face_scale);
+        if !(face_scale > 0.0 && face_scale <= 1.0) {
             return Err(usage(
-                "samples",
-                format!("{samples} must be between 1 and 64"),
+                "face-scale",
+                format!("{face_scale} must be greater than 0 and at most 1"),
             ));
         }
-        let shift = self.shift.unwrap_or(0);
-        if !(-1..=1).contains(&shift) {
-            return Err(usage("shift", format!("{shift} must be -1, 0 or 1")));
-        }
-        let (holes, allowed): (u32, &[u32]) = match scheme {
-            SchemeName::HalfEdge => (self.holes.unwrap_or(0), &[0, 1, 2]),
-            SchemeName::Woven => (self.holes.unwrap_or(2), &[0, 1, 2]),
-            _ => (self.holes.unwrap_or(2), &[0, 1, 2, 4]),
-        };
-        if !allowed.contains(&holes) {
+        let holes = self.holes.unwrap_or(defaults.holes);
+        if !defaults.holes_allowed.contains(&holes) {
             return Err(usage(
                 "holes",
-                format!("{holes} holes per connection; the {scheme} scheme takes {allowed:?}"),
+                format!(
+                    "{holes} holes per connection; the {} scheme takes {:?}",
+                    scheme.name(),
+                    defaults.holes_allowed
+                ),
             ));
         }
         let rotations = self.rotations.unwrap_or(32);
@@ -873,28 +711,25 @@ impl BuildOptions {
                 time_limit,
             },
         };
-        let scheme_options = crate::scheme::SchemeOptions {
+        let panel = PanelOptions {
             face_scale,
-            bridge_scale,
-            flap_scale,
-            samples,
-            shift,
-            tabs: self.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
-            tab_height: length("tab-height", &self.tab_height, "8mm")?,
             holes,
             hole_diameter: length("hole-diameter", &self.hole_diameter, "0.125in")?,
             label_height: length("label-height", &self.label_height, "4mm")?,
-            band_scale,
-            thickness,
-            curl_limit,
-            panel_limit: Some(crate::scheme::PanelLimit {
+            panel_limit: Some(PanelLimit {
                 width: sheet.width - 2.0 * margin,
                 height: sheet.height - 2.0 * margin,
                 rotations,
             }),
         };
+        let options = scheme
+            .configure(&self.scheme_values, panel)
+            .map_err(Error::Usage)?;
+        let scheme = ConfiguredScheme {
+            scheme,
+            options: options.into(),
+        };
         Ok(Job {
-            scheme_options,
             nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
             nest,
             stroke_width: length("stroke-width", &self.stroke_width, "0.001in")?,
@@ -912,21 +747,6 @@ impl BuildOptions {
             formats,
         })
     }
-}
-
-fn parse_formats(text: &str) -> std::result::Result<OutputFormats, String> {
-    let mut formats = OutputFormats {
-        svg: false,
-        dxf: false,
-    };
-    for part in text.split(',') {
-        match part.trim().to_ascii_lowercase().as_str() {
-            "svg" => formats.svg = true,
-            "dxf" => formats.dxf = true,
-            other => return Err(format!("unknown format '{other}'; use svg, dxf or svg,dxf")),
-        }
-    }
-    Ok(formats)
 }
 
 #[cfg(test)]
@@ -985,7 +805,7 @@ mod tests {
         };
         let job = cli.or(file).resolve(Path::new("bunny.obj")).unwrap();
         assert_eq!(job.sheet.name, "A2");
-        assert_eq!(job.scheme, SchemeName::Woven);
+        assert_eq!(job.scheme.name(), "woven");
         assert!(close(job.model.scaling.size.unwrap(), 1219.2));
         assert_eq!(job.out, PathBuf::from("bunny"));
     }

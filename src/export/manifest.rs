@@ -4,16 +4,9 @@
 
 use serde::Serialize;
 
-/// Rounds to 4 decimals (a tenth of a micron is far below any laser's precision) so the
-/// JSON is short and stable.
-pub fn round4(x: f64) -> f64 {
-    let r = (x * 1e4).round() / 1e4;
-    if r == 0.0 {
-        0.0
-    } else {
-        r
-    }
-}
+use crate::record::Params;
+
+pub use crate::record::round4;
 
 /// Rounds to the nanometre: developability errors of exact panels are float noise
 /// (1e-14 mm) that would change with the last bit of a sine; real errors stay visible.
@@ -70,41 +63,9 @@ pub struct FacesSplit {
 pub struct Scheme {
     /// Scheme name.
     pub name: String,
-    /// Parameters (lengths in mm).
-    pub params: SchemeParams,
-}
-
-/// Scheme parameters as used.
-#[derive(Clone, Debug, Serialize)]
-pub struct SchemeParams {
-    /// Face band scale.
-    pub face_scale: f64,
-    /// Edge band control point scale (edge schemes).
-    pub bridge_scale: f64,
-    /// Flap depth fraction (edge schemes).
-    pub flap_scale: f64,
-    /// Bend strips (edge schemes).
-    pub samples: u32,
-    /// Winged-edge wing shift.
-    pub shift: i32,
-    /// Connectors: "tab" or "none".
-    pub connectors: &'static str,
-    /// Wanted tab overlap (mm).
-    pub tab_height: f64,
-    /// Holes per connection.
-    pub holes: u32,
-    /// Hole diameter (mm).
-    pub hole_diameter: f64,
-    /// Wanted label cap height (mm).
-    pub label_height: f64,
-    /// Strand width fraction (woven).
-    pub band_scale: f64,
-    /// Material thickness (mm) between crossing strands (woven).
-    pub thickness: f64,
-    /// Largest ratio of a segment's convex hull to its area (woven).
-    pub curl_limit: f64,
-    /// Millimetres per model unit.
-    pub mm_per_model_unit: f64,
+    /// Parameters as used (lengths in mm): the options every scheme takes, the
+    /// scheme's own, and the scale.
+    pub params: Params,
 }
 
 /// The sheet.
@@ -159,8 +120,6 @@ pub struct Counts {
     pub holes: usize,
     /// Connections between panels.
     pub connections: usize,
-    /// Woven cycles (0 for other schemes).
-    pub cycles: usize,
     /// Labels left out because no legible size fits (all kinds).
     pub labels_left_out: usize,
     /// Of those, panel ids.
@@ -185,8 +144,8 @@ pub struct Lengths {
 pub struct SheetEntry {
     /// 1-based sheet number.
     pub sheet: usize,
-    /// The SVG file name.
-    pub file: String,
+    /// Its files, one per output format (`NAME-01.svg`, `NAME-01.dxf`).
+    pub files: Vec<String>,
     /// Panels on it.
     pub panels: usize,
     /// Panel area / sheet area.
@@ -241,19 +200,6 @@ pub struct PanelEntry {
     pub developability_error: f64,
 }
 
-/// One woven cycle.
-#[derive(Clone, Debug, Serialize)]
-pub struct CycleEntry {
-    /// `C3`.
-    pub id: String,
-    /// Mesh edges it crosses.
-    pub edges: usize,
-    /// Centre-line length of its ribbon (mm).
-    pub length: f64,
-    /// Segments it is cut into (panels `C3.1` …).
-    pub segments: usize,
-}
-
 /// The whole manifest.
 #[derive(Clone, Debug, Serialize)]
 pub struct Manifest {
@@ -283,9 +229,9 @@ pub struct Manifest {
     /// their labels), each naming its fix.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
-    /// Woven cycles (woven scheme only).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub cycles: Vec<CycleEntry>,
+    /// What only the scheme makes (the woven scheme's `cycles`).
+    #[serde(flatten)]
+    pub scheme_sections: Params,
     /// The output sheets.
     pub sheets: Vec<SheetEntry>,
     /// Every file the run wrote into the output folder, this manifest last: a later

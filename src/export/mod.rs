@@ -45,6 +45,72 @@ pub trait SheetSink {
     fn circle(&mut self, kind: Kind, center: DVec2, radius: f64);
 }
 
+/// The sheet file formats: each is a sink with its file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    /// One SVG per sheet, in millimetres (the laser's own vector format).
+    Svg,
+    /// One R12 DXF per sheet, in millimetres.
+    Dxf,
+}
+
+impl Format {
+    /// Every format, in the order files are written.
+    pub const ALL: [Format; 2] = [Format::Svg, Format::Dxf];
+
+    /// Its name for `--format`, also the file extension.
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Svg => "svg",
+            Format::Dxf => "dxf",
+        }
+    }
+
+    /// Parses a `--format` list ("svg,dxf") into formats in [`Format::ALL`] order.
+    pub fn parse_list(text: &str) -> Result<Vec<Format>, String> {
+        let mut chosen = Vec::new();
+        for part in text.split(',') {
+            let name = part.trim().to_ascii_lowercase();
+            let format = Format::ALL
+                .into_iter()
+                .find(|f| f.extension() == name)
+                .ok_or_else(|| format!("unknown format '{name}'; use svg, dxf or svg,dxf"))?;
+            chosen.push(format);
+        }
+        Ok(Format::ALL
+            .into_iter()
+            .filter(|f| chosen.contains(f))
+            .collect())
+    }
+
+    /// Sheet `index` of `layout` in this format.
+    pub fn write_sheet(
+        self,
+        layout: &Layout,
+        index: usize,
+        panels: &FlatPanels,
+        stroke_width: f64,
+    ) -> Vec<u8> {
+        let sheet = &layout.sheet;
+        match self {
+            Format::Svg => {
+                let style = svg::SvgStyle {
+                    stroke_width,
+                    ..svg::SvgStyle::default()
+                };
+                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
+                draw_sheet(layout, index, panels, &mut sink);
+                sink.finish().into_bytes()
+            }
+            Format::Dxf => {
+                let mut sink = dxf::DxfSheet::new(sheet.width, sheet.height);
+                draw_sheet(layout, index, panels, &mut sink);
+                sink.finish().into_bytes()
+            }
+        }
+    }
+}
+
 /// Lengths of what a sheet (or a run) draws, per kind (mm).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Lengths {

@@ -26,14 +26,9 @@ pub enum Budget {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum SimplifyMode {
-    /// Even triangle sizes and shapes (meshoptimizer's `Regularize`, then a relaxation
-    /// toward even edges that keeps the deviation), at some cost in closeness to the
-    /// original surface. Every edge becomes a panel, so even edges make panels of one
-    /// size that assemble alike and lose less to the spacing: the bunny at 625 edges
-    /// has its longest edge 2.0 times the median instead of 3.4 and 95 % of its edges
-    /// within 1.44 times it, and quad-edge at 4 ft its outlines grown by half the
-    /// spacing cover 9.76 usable sheets (the bound counting the spacing: 10) instead of
-    /// 10.18 (11).
+    /// Even triangle sizes and shapes, at some cost in closeness to the original
+    /// surface: every edge becomes a panel, so panels come out of one size, assemble
+    /// alike and lose less to the spacing.
     #[default]
     Regular,
     /// The closest surface for the budget: flat regions keep few, large triangles and

@@ -3,18 +3,18 @@
 //!
 //! Collision detection is jagua-rs (every part inflated by half the spacing, the sheet
 //! grown by the same amount); the search is ours:
-//! 1. constructive, twice, side by side: in rows ([`rows`]: parts lie flat, tallest
+//! 1. constructive, twice, side by side: in rows (`rows`: parts lie flat, tallest
 //!    first, each dropped at the end of the current row and slid down and left until
 //!    it rests, the next part chosen among the next few by how little of the row it
 //!    claims, so slanted ends interlock), and first-fit decreasing (parts largest
 //!    first, each into the first sheet where a sampled, then slid, bottom-left
 //!    position is free, poses that touch their neighbours scoring better
-//!    ([`CONTACT_WEIGHT`]));
+//!    (`CONTACT_WEIGHT`));
 //! 2. improvement, of each construction: the emptiest sheet is emptied into the
 //!    others, part by part, by the sampled pose search; a sheet left empty is dropped.
 //!    Partial moves are kept: they only make the emptiest sheet emptier (the second
 //!    objective). The better of the two layouts goes on;
-//! 3. squeezing by overlap minimisation ([`separate`]): the emptiest sheet's parts,
+//! 3. squeezing by overlap minimisation (`separate`): the emptiest sheet's parts,
 //!    largest first, go one at a time to where they overlap least on one of the
 //!    emptiest other sheets, which is then separated by a guided local search; a part
 //!    stays only when that succeeds, and the squeeze stops at the first part that
@@ -496,7 +496,7 @@ fn fill_grid(grid: &mut Grid, layout: &JLayout, key: PItemKey) {
 }
 
 fn too_large(part: usize, outline: &[DVec2], sheet: SheetSpec, rotations: u32) -> TooLarge {
-    let size = super::shelf::smallest_box(outline, rotations);
+    let size = crate::plane::smallest_box(outline, rotations);
     TooLarge {
         part,
         width: size.x,

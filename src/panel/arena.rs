@@ -28,7 +28,7 @@ pub trait Arena: Default + Send {
     fn append(&mut self, other: Self);
 }
 
-/// An arena that hands its panels out as views ([`Panels`], [`FlatPanels`]).
+/// An arena that hands its panels out as views ([`crate::panel::Panels`], [`crate::panel::FlatPanels`]).
 pub trait Views {
     /// How a panel is handed out.
     type View<'a>

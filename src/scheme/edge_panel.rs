@@ -8,10 +8,70 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::{face_band, SchemeOptions};
+use super::{face_band, fraction, PanelOptions};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
+use crate::record::Params;
+
+/// The options of the edge band, shared by the edge schemes, as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub struct BandArgs {
+    /// Edge band control points: b·v + (1−b)·m toward the edge midpoint m; smaller b
+    /// makes the bend rounder. [default: 0.5]
+    #[arg(long, value_name = "B")]
+    pub bridge_scale: Option<f64>,
+
+    /// Flap depth: the flap's inner line joins the band corners moved this fraction
+    /// toward the face centre. [default: 0.5]
+    #[arg(long, value_name = "F")]
+    pub flap_scale: Option<f64>,
+
+    /// Strips of the Bézier bend; every ruling between two strips is a score line.
+    /// [default: 4]
+    #[arg(long, value_name = "N")]
+    pub samples: Option<u32>,
+}
+
+impl BandArgs {
+    /// Checks the values and fills in the defaults.
+    pub fn resolve(&self, panel: PanelOptions) -> Result<EdgeOptions, String> {
+        let samples = self.samples.unwrap_or(4);
+        if !(1..=64).contains(&samples) {
+            return Err(format!("--samples: {samples} must be between 1 and 64"));
+        }
+        Ok(EdgeOptions {
+            panel,
+            bridge_scale: fraction("bridge-scale", self.bridge_scale, 0.5)?,
+            flap_scale: fraction("flap-scale", self.flap_scale, 0.5)?,
+            samples,
+        })
+    }
+}
+
+/// The options of the edge schemes, resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EdgeOptions {
+    /// The options every scheme takes.
+    pub panel: PanelOptions,
+    /// Edge band control points `b·v + (1−b)·m`.
+    pub bridge_scale: f64,
+    /// Flap inner line at this fraction toward the face centre.
+    pub flap_scale: f64,
+    /// Strips of the Bézier bend.
+    pub samples: u32,
+}
+
+impl EdgeOptions {
+    /// The band's parameters for the manifest.
+    pub fn params(&self) -> Params {
+        let mut params = Params::default();
+        params.push("bridge_scale", self.bridge_scale);
+        params.push("flap_scale", self.flap_scale);
+        params.push("samples", self.samples);
+        params
+    }
+}
 
 /// The id printed for an edge panel.
 pub fn panel_id(e: EdgeId) -> Name {
@@ -157,14 +217,10 @@ impl FaceFrame {
 /// the face's plane (through its centre, normal to its vector area), so every flap is
 /// an exactly planar facet and the holes of a corner lie on both flaps even when the
 /// face is planar only within the tolerance; on a planar face nothing moves.
-pub fn band(
-    mesh: &Mesh,
-    f: FaceId,
-    options: &SchemeOptions,
-) -> (Vec<DVec3>, Vec<DVec2>, FaceFrame) {
+pub fn band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> (Vec<DVec3>, Vec<DVec2>, FaceFrame) {
     let frame = FaceFrame::new(mesh, f);
     let normal = frame.ex.cross(frame.ey);
-    let band: Vec<DVec3> = face_band(mesh, f, options.face_scale)
+    let band: Vec<DVec3> = face_band(mesh, f, options.panel.face_scale)
         .into_iter()
         .map(|p| p - (p - frame.centre).dot(normal) * normal)
         .collect();
@@ -223,8 +279,8 @@ pub fn place_pins(
 /// report lines.
 pub fn edge_scheme(
     mesh: &Mesh,
-    options: &SchemeOptions,
-    face_flaps: impl Fn(&Mesh, FaceId, &SchemeOptions) -> FaceFlaps + Sync,
+    options: &EdgeOptions,
+    face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> super::SchemeOutput {
     let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
         .into_par_iter()
@@ -236,7 +292,7 @@ pub fn edge_scheme(
         panels,
         connections,
         notes: edge_scheme_notes(mesh, &faces, connections, options),
-        cycles: Vec::new(),
+        ..super::SchemeOutput::default()
     }
 }
 
@@ -245,7 +301,7 @@ pub fn edge_scheme_notes(
     mesh: &Mesh,
     faces: &[FaceFlaps],
     connections: usize,
-    options: &SchemeOptions,
+    options: &EdgeOptions,
 ) -> Vec<String> {
     let reduced: usize = faces.iter().map(|f| f.reduced).sum();
     let bare: usize = faces.iter().map(|f| f.bare).sum();
@@ -253,7 +309,7 @@ pub fn edge_scheme_notes(
     if reduced > 0 {
         notes.push(format!(
             "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlap cannot hold more {} mm holes with one diameter of material around each; a larger --size, smaller --hole-diameter or larger --flap-scale helps",
-            options.holes, options.hole_diameter
+            options.panel.holes, options.panel.hole_diameter
         ));
     }
     let boundary = mesh.edges().filter(|&e| mesh.is_boundary_edge(e)).count();
@@ -266,7 +322,7 @@ pub fn edge_scheme_notes(
 }
 
 /// Builds every edge panel from the faces' flaps. Returns the panels (in edge order).
-pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &SchemeOptions) -> Panels {
+pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &EdgeOptions) -> Panels {
     let mut corner_of = vec![0u32; mesh.half_edge_count()];
     for f in mesh.faces() {
         for (k, h) in mesh.face_half_edges(f).enumerate() {
@@ -292,7 +348,7 @@ fn edge_panel(
     e: EdgeId,
     faces: &[FaceFlaps],
     corner_of: &[u32],
-    options: &SchemeOptions,
+    options: &EdgeOptions,
 ) -> Panel {
     // Work from a half-edge that has a face (boundary edges have one).
     let h = if mesh.is_boundary_half_edge(e.half_edge()) {
@@ -365,7 +421,7 @@ fn edge_panel(
         );
         holes.extend(part.flap_holes(edge).map(|(p, connection)| Hole {
             position: p,
-            diameter: options.hole_diameter,
+            diameter: options.panel.hole_diameter,
             connection,
             facet,
         }));
@@ -394,7 +450,7 @@ fn edge_panel(
         text: panel_id(e),
         anchor: corners.iter().map(|&i| vertices[i as usize]).sum::<DVec3>() / corners.len() as f64,
         direction: (b - a).normalize(),
-        height: options.label_height,
+        height: options.panel.label_height,
         facet: id_facet as u32,
         kind: LabelKind::Panel,
         on_edge: false,
@@ -421,7 +477,7 @@ fn flap_labels(
     he: HalfEdgeId,
     corner: usize,
     facet: u32,
-    options: &SchemeOptions,
+    options: &EdgeOptions,
     labels: &mut Vec<Label>,
 ) {
     let next_corner = (corner + 1) % part.corners();
@@ -439,7 +495,7 @@ fn flap_labels(
             // Between the flap's middle and the pins at that corner.
             anchor: 0.5 * (middle + part.corner_label(c)),
             direction: along,
-            height: options.label_height,
+            height: options.panel.label_height,
             facet,
             kind: LabelKind::Partner,
             on_edge: false,
@@ -451,7 +507,7 @@ fn flap_labels(
             text: Name::Vertex(vertex.0),
             anchor: part.corner_label(c),
             direction: along,
-            height: options.label_height,
+            height: options.panel.label_height,
             facet,
             kind: LabelKind::Mark,
             on_edge: false,
@@ -462,7 +518,7 @@ fn flap_labels(
         text: Name::Face(face.0),
         anchor: middle,
         direction: along,
-        height: options.label_height,
+        height: options.panel.label_height,
         facet,
         kind: LabelKind::Mark,
         on_edge: false,

@@ -10,10 +10,14 @@
 
 use glam::{DVec2, DVec3};
 
-use super::{face_band, SchemeOptions, SchemeOutput};
+use super::{
+    args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
+    SchemeOutput,
+};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
+use crate::record::{round4, Params};
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
 /// outline, plus the fastener holes through it and the neighbour.
@@ -82,6 +86,103 @@ impl Tabs {
     }
 }
 
+/// The half-edge scheme: one panel per face, tabs on interior edges.
+pub struct HalfEdge;
+
+/// Connector kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Connectors {
+    /// A glue or pin tab on one of the two panels.
+    Tab,
+    /// Nothing: panels meet edge to edge.
+    None,
+}
+
+/// The half-edge options as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct HalfEdgeArgs {
+    /// Connectors on interior edges: tab or none. [default: tab]
+    #[arg(long, value_name = "KIND")]
+    connectors: Option<Connectors>,
+
+    /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
+    /// where the neighbour is smaller. [default: 8mm]
+    #[arg(long, value_name = "LENGTH")]
+    tab_height: Option<String>,
+}
+
+/// The half-edge scheme's options, resolved (lengths in mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct HalfEdgeOptions {
+    /// The options every scheme takes.
+    pub panel: PanelOptions,
+    /// Tabs on interior edges.
+    pub tabs: bool,
+    /// Wanted height of a tab's overlap with its neighbour (mm).
+    pub tab_height: f64,
+}
+
+impl Scheme for HalfEdge {
+    fn name(&self) -> &'static str {
+        "half-edge"
+    }
+
+    fn about(&self) -> &'static str {
+        "one panel per face, tabs on interior edges"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        args_of::<HalfEdgeArgs>()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            face_scale: 1.0,
+            holes: 0,
+            holes_allowed: &[0, 1, 2],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // A tab lies in the neighbour face along one edge: star-shaped faces suffice.
+        false
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        let args: HalfEdgeArgs = values.parse()?;
+        Ok(Box::new(HalfEdgeOptions {
+            panel,
+            tabs: args.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
+            tab_height: super::positive_length("tab-height", args.tab_height.as_deref(), "8mm")?,
+        }))
+    }
+}
+
+impl Configured for HalfEdgeOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        Ok(panels(mesh, self))
+    }
+
+    fn params(&self) -> Params {
+        let mut params = Params::default();
+        params.push("connectors", if self.tabs { "tab" } else { "none" });
+        params.push("tab_height", round4(self.tab_height));
+        params
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
 /// The id printed for a face panel.
 pub fn panel_id(f: FaceId) -> Name {
     Name::Face(f.0)
@@ -89,7 +190,7 @@ pub fn panel_id(f: FaceId) -> Name {
 
 /// Builds the face panels of a mesh whose faces are planar and star-shaped from their
 /// centres (the split stage ensures both).
-pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
+pub fn panels(mesh: &Mesh, options: &HalfEdgeOptions) -> SchemeOutput {
     // Tabs per edge (interior edges only), computed independently in parallel and
     // collected in edge order.
     let made: Result<Tabs, std::convert::Infallible> = fill_arena(mesh.edge_count(), |e| {
@@ -129,7 +230,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
     if skipped > 0 {
         notes.push(format!(
             "{skipped} connections have no fastener holes: the tab is too small for a {} mm hole",
-            options.hole_diameter
+            options.panel.hole_diameter
         ));
     }
 
@@ -138,7 +239,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
         face_panel(
             mesh,
             f,
-            &face_band(mesh, f, options.face_scale),
+            &face_band(mesh, f, options.panel.face_scale),
             &tabs,
             options,
         )
@@ -147,7 +248,7 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
         panels,
         connections,
         notes,
-        cycles: Vec::new(),
+        ..SchemeOutput::default()
     }
 }
 
@@ -157,9 +258,9 @@ fn face_panel(
     f: FaceId,
     band: &[DVec3],
     tabs: &Tabs,
-    options: &SchemeOptions,
+    options: &HalfEdgeOptions,
 ) -> Panel {
-    let s = options.face_scale;
+    let s = options.panel.face_scale;
     let mut vertices: Vec<DVec3> = band.to_vec();
     let add = |p: DVec3, vertices: &mut Vec<DVec3>| {
         vertices.push(p);
@@ -217,7 +318,7 @@ fn face_panel(
         for &p in &tab.holes {
             holes.push(Hole {
                 position: p,
-                diameter: options.hole_diameter,
+                diameter: options.panel.hole_diameter,
                 connection: tab.owner.edge().0,
                 facet: facet_index,
             });
@@ -229,7 +330,7 @@ fn face_panel(
             for &p in &tab.holes {
                 holes.push(Hole {
                     position: p,
-                    diameter: options.hole_diameter,
+                    diameter: options.panel.hole_diameter,
                     connection: tab.owner.edge().0,
                     facet: 0,
                 });
@@ -251,7 +352,7 @@ fn face_panel(
         text: panel_id(f),
         anchor: centre,
         direction: (band[(longest + 1) % n] - band[longest]).normalize(),
-        height: options.label_height,
+        height: options.panel.label_height,
         facet: 0,
         kind: LabelKind::Panel,
         on_edge: false,
@@ -269,7 +370,7 @@ fn face_panel(
             text: panel_id(g),
             anchor: 0.5 * (a + b),
             direction: (b - a).normalize(),
-            height: options.label_height,
+            height: options.panel.label_height,
             facet: 0,
             kind: LabelKind::Partner,
             on_edge: true,
@@ -283,7 +384,7 @@ fn face_panel(
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
 /// `None` when the neighbour cannot hold one.
-fn make_tab(mesh: &Mesh, owner: HalfEdgeId, options: &SchemeOptions) -> Option<Tab> {
+fn make_tab(mesh: &Mesh, owner: HalfEdgeId, options: &HalfEdgeOptions) -> Option<Tab> {
     let g = mesh.face(owner.twin())?;
     let (a, b) = (
         mesh.position(mesh.origin(owner)),
@@ -300,7 +401,7 @@ fn make_tab(mesh: &Mesh, owner: HalfEdgeId, options: &SchemeOptions) -> Option<T
     if centre.y <= 0.0 {
         return None;
     }
-    let s = options.face_scale;
+    let s = options.panel.face_scale;
     let gap = (1.0 - s) * centre.y;
     let wanted = gap + options.tab_height;
     // Inset the base a little from the corners so tabs from neighbouring edges that
@@ -362,13 +463,13 @@ fn place_holes(
     top_height: f64,
     neighbour_band: &[DVec3],
     to2: &dyn Fn(DVec3) -> DVec2,
-    options: &SchemeOptions,
+    options: &HalfEdgeOptions,
 ) -> (Vec<DVec2>, bool) {
-    let count = options.holes;
+    let count = options.panel.holes;
     if count == 0 {
         return (Vec::new(), false);
     }
-    let r = 0.5 * options.hole_diameter;
+    let r = 0.5 * options.panel.hole_diameter;
     let clearance = 2.0 * r;
     let v = 0.5 * (gap + top_height);
     // The tab's extent at height v (it is convex: two crossings).

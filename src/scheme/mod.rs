@@ -1,7 +1,11 @@
 //! Panel schemes: each takes a read-only mesh (in millimetres) and its options and
 //! returns 3D panels with provenance. A scheme knows nothing of sheets or files.
 //!
-//! Adding a scheme: one file here and one arm in [`build_panels`].
+//! A scheme is one file here: a type implementing [`Scheme`] (its name, help, its own
+//! command-line and config options with their defaults and checks, whether it needs
+//! convex faces) and the [`Configured`] value it resolves to (the build, and what it
+//! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
+//! module reaches the schemes only through a [`Registry`].
 
 pub mod edge_panel;
 pub mod half_edge;
@@ -9,43 +13,83 @@ pub mod quad_edge;
 pub mod winged_edge;
 pub mod woven;
 
+use std::any::Any;
+use std::collections::BTreeMap;
+use std::fmt;
+use std::sync::Arc;
+
 use glam::DVec3;
 
-use crate::config::SchemeName;
 use crate::mesh::{FaceId, Mesh};
 use crate::panel::Panels;
+use crate::record::{round4, Params};
 
-/// Options shared by the schemes (lengths in mm, fractions as fractions).
+/// The built-in schemes, in the order `--help` lists them; the first is the default.
+pub static SCHEMES: [&dyn Scheme; 4] = [
+    &half_edge::HalfEdge,
+    &quad_edge::QuadEdge,
+    &winged_edge::WingedEdge,
+    &woven::Woven,
+];
+
+/// A panel scheme: what the command line, the config file and the pipeline need of it.
+pub trait Scheme: Send + Sync {
+    /// Its name for `--scheme` (kebab-case).
+    fn name(&self) -> &'static str;
+    /// One sentence for `--help`.
+    fn about(&self) -> &'static str;
+    /// Its own options (clap arguments with long names; the config file takes the same
+    /// keys). Schemes may share an option by declaring the same argument.
+    fn options(&self) -> Vec<clap::Arg> {
+        Vec::new()
+    }
+    /// Its defaults for the options every scheme takes.
+    fn defaults(&self) -> PanelDefaults;
+    /// True when its faces must be convex (the rest are split into triangles first).
+    fn needs_convex_faces(&self) -> bool;
+    /// Checks its own option `values` and fills in their defaults. An error is a usage
+    /// message naming the option (`--bridge-scale: ...`).
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String>;
+}
+
+/// A scheme with its options resolved, ready to build panels.
+pub trait Configured: fmt::Debug + Send + Sync + Any {
+    /// The options every scheme takes, as resolved.
+    fn panel(&self) -> &PanelOptions;
+    /// Builds the panels of `mesh` (millimetres, faces as the scheme needs them).
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError>;
+    /// Its own options as used, for the manifest's `scheme.params` (lengths in mm).
+    fn params(&self) -> Params;
+    /// For callers that know the concrete type (tests, benches).
+    fn as_any(&self) -> &dyn Any;
+}
+
+/// Defaults a scheme gives the options every scheme takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanelDefaults {
+    /// `--face-scale`.
+    pub face_scale: f64,
+    /// `--holes`.
+    pub holes: u32,
+    /// The hole counts per connection it can place.
+    pub holes_allowed: &'static [u32],
+}
+
+/// Options every scheme takes (lengths in mm, fractions as fractions).
 #[derive(Clone, Debug, PartialEq)]
-pub struct SchemeOptions {
+pub struct PanelOptions {
     /// Face band scale `s`: corners move toward the face centre, `s·v + (1−s)·c`.
     pub face_scale: f64,
-    /// Edge band control points `b·v + (1−b)·m` (quad-edge).
-    pub bridge_scale: f64,
-    /// Flap inner line at this fraction toward the face centre (quad-edge).
-    pub flap_scale: f64,
-    /// Strips of the Bézier bend (quad-edge).
-    pub samples: u32,
-    /// Winged-edge wings: 0 both half-length, 1 one full-length wing on the next edge,
-    /// −1 on the previous edge.
-    pub shift: i32,
-    /// Tabs on interior edges (half-edge scheme).
-    pub tabs: bool,
-    /// Wanted height of a tab's overlap with its neighbour (mm).
-    pub tab_height: f64,
     /// Fastener holes per connection.
     pub holes: u32,
     /// Hole diameter (mm).
     pub hole_diameter: f64,
     /// Wanted label cap height (mm).
     pub label_height: f64,
-    /// Strand width as a fraction of the band side (woven).
-    pub band_scale: f64,
-    /// Material thickness (mm): woven strands cross this far apart.
-    pub thickness: f64,
-    /// A woven segment's convex hull is at most this many times its area: curling
-    /// ribbons are cut into pieces that nest.
-    pub curl_limit: f64,
     /// The largest panel the layout can take; schemes that can cut long panels
     /// (woven ribbons) cut them to fit. `None`: no limit.
     pub panel_limit: Option<PanelLimit>,
@@ -63,6 +107,267 @@ pub struct PanelLimit {
     pub rotations: u32,
 }
 
+/// Option values as the user wrote them, by long option name (`"bridge-scale"` →
+/// `"0.4"`; a switch is `"true"` or `"false"`). The command line and the config file
+/// both fill it, so a scheme parses its options in one place.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct OptionValues {
+    values: BTreeMap<String, String>,
+    /// Names whose value came from a config file, which may hold options of several
+    /// schemes; the others were asked for explicitly.
+    from_file: std::collections::BTreeSet<String>,
+}
+
+impl OptionValues {
+    /// Sets `name` (a long option name without dashes) to `text`, as asked for on the
+    /// command line.
+    pub fn set(&mut self, name: &str, text: &str) {
+        self.values.insert(name.to_string(), text.to_string());
+        self.from_file.remove(name);
+    }
+
+    /// Sets `name` to `text` from a config file.
+    pub fn set_from_file(&mut self, name: &str, text: &str) {
+        self.values.insert(name.to_string(), text.to_string());
+        self.from_file.insert(name.to_string());
+    }
+
+    /// The value of `name`, if given.
+    pub fn get(&self, name: &str) -> Option<&str> {
+        self.values.get(name).map(String::as_str)
+    }
+
+    /// The names asked for explicitly (not from a config file).
+    pub fn asked(&self) -> impl Iterator<Item = &str> {
+        self.values
+            .keys()
+            .filter(|n| !self.from_file.contains(*n))
+            .map(String::as_str)
+    }
+
+    /// These values, with `other`'s where this has none.
+    pub fn or(mut self, other: OptionValues) -> OptionValues {
+        for (name, text) in other.values {
+            if !self.values.contains_key(&name) {
+                if other.from_file.contains(&name) {
+                    self.from_file.insert(name.clone());
+                }
+                self.values.insert(name, text);
+            }
+        }
+        self
+    }
+
+    /// Parses the values of `T`'s arguments with `T`'s own definitions (values of
+    /// other schemes' options are not `T`'s business and are skipped).
+    pub fn parse<T: clap::Args + clap::FromArgMatches>(&self) -> Result<T, String> {
+        let command = T::augment_args(clap::Command::new("unfold").no_binary_name(true));
+        let mut argv: Vec<String> = Vec::new();
+        for arg in command.get_arguments() {
+            let Some(long) = arg.get_long() else { continue };
+            let Some(text) = self.get(long) else { continue };
+            if matches!(arg.get_action(), clap::ArgAction::SetTrue) {
+                if text == "true" {
+                    argv.push(format!("--{long}"));
+                }
+            } else {
+                argv.push(format!("--{long}={text}"));
+            }
+        }
+        let matches = command.try_get_matches_from(argv).map_err(|e| {
+            e.to_string()
+                .trim()
+                .trim_start_matches("error: ")
+                .to_string()
+        })?;
+        T::from_arg_matches(&matches).map_err(|e| e.to_string())
+    }
+}
+
+/// A positive length option (`--tab-height`): `text` or else `default`, in mm.
+pub fn positive_length(option: &str, text: Option<&str>, default: &str) -> Result<f64, String> {
+    let text = text.unwrap_or(default);
+    match crate::units::parse_length(text) {
+        Ok(mm) if mm > 0.0 => Ok(mm),
+        Ok(_) => Err(format!("--{option}: '{text}' must be positive")),
+        Err(e) => Err(format!("--{option}: {e}")),
+    }
+}
+
+/// A fraction option in (0, 1]: `value` or else `default`.
+pub fn fraction(option: &str, value: Option<f64>, default: f64) -> Result<f64, String> {
+    let x = value.unwrap_or(default);
+    if x > 0.0 && x <= 1.0 {
+        Ok(x)
+    } else {
+        Err(format!(
+            "--{option}: {x} must be greater than 0 and at most 1"
+        ))
+    }
+}
+
+/// The arguments of an options type, for [`Scheme::options`].
+pub fn args_of<T: clap::Args>() -> Vec<clap::Arg> {
+    T::augment_args(clap::Command::new("unfold"))
+        .get_arguments()
+        .cloned()
+        .collect()
+}
+
+/// The schemes a run can choose from: the built-in ones, and any a program embedding
+/// the library adds with [`Registry::with`].
+#[derive(Clone)]
+pub struct Registry {
+    schemes: Vec<&'static dyn Scheme>,
+}
+
+impl Default for Registry {
+    fn default() -> Self {
+        Registry {
+            schemes: SCHEMES.to_vec(),
+        }
+    }
+}
+
+impl fmt::Debug for Registry {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_list().entries(self.names()).finish()
+    }
+}
+
+impl Registry {
+    /// The built-in schemes plus `scheme`.
+    pub fn with(mut self, scheme: &'static dyn Scheme) -> Registry {
+        self.schemes.push(scheme);
+        self
+    }
+
+    /// Scheme names, in order.
+    pub fn names(&self) -> Vec<&'static str> {
+        self.schemes.iter().map(|s| s.name()).collect()
+    }
+
+    /// The schemes, in order.
+    pub fn schemes(&self) -> &[&'static dyn Scheme] {
+        &self.schemes
+    }
+
+    /// The scheme called `name`.
+    pub fn get(&self, name: &str) -> Option<&'static dyn Scheme> {
+        self.schemes.iter().copied().find(|s| s.name() == name)
+    }
+
+    /// The scheme used when none is given.
+    pub fn default_scheme(&self) -> &'static dyn Scheme {
+        self.schemes[0]
+    }
+
+    /// Every scheme's own options, each once (schemes that share one share its
+    /// definition), headed in `--help` by the schemes that take it.
+    pub fn options(&self) -> Vec<clap::Arg> {
+        let mut options: Vec<(clap::Arg, Vec<&str>)> = Vec::new();
+        for scheme in &self.schemes {
+            for arg in scheme.options() {
+                match options.iter_mut().find(|(a, _)| a.get_id() == arg.get_id()) {
+                    Some((_, takers)) => takers.push(scheme.name()),
+                    None => options.push((arg, vec![scheme.name()])),
+                }
+            }
+        }
+        options
+            .into_iter()
+            .map(|(arg, takers)| arg.help_heading(format!("Options of {}", name_list(&takers))))
+            .collect()
+    }
+
+    /// "1 for half-edge, 0.5 for quad-edge and winged-edge": a per-scheme default as
+    /// `--help` states it.
+    pub fn describe_defaults<T: PartialEq + fmt::Display>(
+        &self,
+        value: impl Fn(&PanelDefaults) -> T,
+    ) -> String {
+        let mut groups: Vec<(T, Vec<&str>)> = Vec::new();
+        for scheme in &self.schemes {
+            let v = value(&scheme.defaults());
+            match groups.iter_mut().find(|(g, _)| *g == v) {
+                Some((_, names)) => names.push(scheme.name()),
+                None => groups.push((v, vec![scheme.name()])),
+            }
+        }
+        groups
+            .iter()
+            .map(|(v, names)| format!("{v} for {}", name_list(names)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+}
+
+/// "a", "a and b", "a, b and c".
+fn name_list(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
+    }
+}
+
+/// A scheme with its options resolved: what a job runs.
+#[derive(Clone)]
+pub struct ConfiguredScheme {
+    /// The scheme.
+    pub scheme: &'static dyn Scheme,
+    /// Its resolved options.
+    pub options: Arc<dyn Configured>,
+}
+
+impl ConfiguredScheme {
+    /// The scheme's name.
+    pub fn name(&self) -> &'static str {
+        self.scheme.name()
+    }
+
+    /// The options every scheme takes.
+    pub fn panel(&self) -> &PanelOptions {
+        self.options.panel()
+    }
+
+    /// The scheme's own options, when they are a `T`.
+    pub fn options_as<T: 'static>(&self) -> Option<&T> {
+        self.options.as_any().downcast_ref::<T>()
+    }
+
+    /// Builds the panels of `mesh`.
+    pub fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        self.options.build(mesh)
+    }
+
+    /// The manifest's `scheme.params`: the shared options, then the scheme's own.
+    pub fn params(&self) -> Params {
+        let panel = self.panel();
+        let mut params = Params::default();
+        params.push("face_scale", panel.face_scale);
+        params.push("holes", panel.holes);
+        params.push("hole_diameter", round4(panel.hole_diameter));
+        params.push("label_height", round4(panel.label_height));
+        params.extend(self.options.params());
+        params
+    }
+}
+
+impl fmt::Debug for ConfiguredScheme {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} {:?}", self.name(), self.options)
+    }
+}
+
+impl PartialEq for ConfiguredScheme {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+            && self.panel() == other.panel()
+            && self.params() == other.params()
+    }
+}
+
 /// What a scheme produced.
 #[derive(Clone, Debug, Default)]
 pub struct SchemeOutput {
@@ -72,8 +377,10 @@ pub struct SchemeOutput {
     pub connections: usize,
     /// Observations for the report (tabs shortened or left out, holes skipped).
     pub notes: Vec<String>,
-    /// Woven cycles (empty for the other schemes).
-    pub cycles: Vec<woven::CycleSummary>,
+    /// Lines the report prints about what only this scheme makes (the woven cycles).
+    pub report: Vec<String>,
+    /// Sections the manifest gets about them, after its warnings.
+    pub manifest: Params,
 }
 
 /// Errors a scheme reports (options it cannot honour).
@@ -92,26 +399,6 @@ impl SchemeError {
     /// does not suit the scheme at this size.
     pub fn is_usage(&self) -> bool {
         matches!(self, SchemeError::Weave(_))
-    }
-}
-
-/// True when the scheme needs convex faces (its flaps follow the neighbouring band
-/// edges, which only bound a flap inside a convex face).
-pub fn needs_convex_faces(name: SchemeName) -> bool {
-    !matches!(name, SchemeName::HalfEdge)
-}
-
-/// Runs the named scheme.
-pub fn build_panels(
-    name: SchemeName,
-    mesh: &Mesh,
-    options: &SchemeOptions,
-) -> Result<SchemeOutput, SchemeError> {
-    match name {
-        SchemeName::HalfEdge => Ok(half_edge::panels(mesh, options)),
-        SchemeName::QuadEdge => Ok(quad_edge::panels(mesh, options)),
-        SchemeName::WingedEdge => Ok(winged_edge::panels(mesh, options)),
-        SchemeName::Woven => woven::panels(mesh, options),
     }
 }
 

@@ -19,20 +19,81 @@
 
 use glam::DVec2;
 
-use super::edge_panel::{band, corner_half_edges, edge_scheme, place_pins, FaceFlaps};
-use super::{SchemeOptions, SchemeOutput};
+use super::edge_panel::{
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use super::{SchemeError, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
 use crate::plane::clip_half_plane;
+use crate::record::Params;
 
 pub use super::edge_panel::panel_id;
 
+/// The quad-edge scheme: one panel per edge, joined at face corners.
+pub struct QuadEdge;
+
+impl Scheme for QuadEdge {
+    fn name(&self) -> &'static str {
+        "quad-edge"
+    }
+
+    fn about(&self) -> &'static str {
+        "one panel per edge: Bézier edge bands with flaps, joined at face corners"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        args_of::<BandArgs>()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            face_scale: 0.5,
+            holes: 2,
+            holes_allowed: &[0, 1, 2, 4],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // The flaps follow the neighbouring band edges, which bound a flap only inside
+        // a convex face.
+        true
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        Ok(Box::new(values.parse::<BandArgs>()?.resolve(panel)?))
+    }
+}
+
+impl Configured for EdgeOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        Ok(panels(mesh, self))
+    }
+
+    fn params(&self) -> Params {
+        EdgeOptions::params(self)
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
 /// Builds the edge panels of a mesh whose faces are planar and convex.
-pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
+pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
     edge_scheme(mesh, options, face_flaps)
 }
 
 /// Band, flaps and corner overlaps of one face, computed in its plane.
-fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
+fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
@@ -76,11 +137,11 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
             &overlap,
             centre,
             centre - b[k],
-            options.holes,
-            options.hole_diameter,
+            options.panel.holes,
+            options.panel.hole_diameter,
         );
         parts.reduced += fewer as usize;
-        parts.bare += (options.holes > 0 && pins.is_empty()) as usize;
+        parts.bare += (options.panel.holes > 0 && pins.is_empty()) as usize;
         // The connection at corner k is named by the half-edge leaving it; both flaps
         // meeting there carry its holes.
         let connection = half_edges[k].0;

@@ -15,16 +15,111 @@
 
 use glam::DVec2;
 
-use super::edge_panel::{band, corner_half_edges, edge_scheme, place_pins, FaceFlaps};
-use super::{SchemeOptions, SchemeOutput};
+use super::edge_panel::{
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use super::{SchemeError, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
+use crate::record::Params;
 
-/// Builds the winged edge panels of a mesh whose faces are planar and convex.
-pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> SchemeOutput {
-    edge_scheme(mesh, options, face_flaps)
+/// The winged-edge scheme: quad-edge panels with wings along the neighbouring edges.
+pub struct WingedEdge;
+
+/// The winged-edge options as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct WingedEdgeArgs {
+    #[command(flatten)]
+    band: BandArgs,
+
+    /// Wings: 0 = a half-length wing on each side, 1 = one full-length wing over the
+    /// next edge's flap, -1 = over the previous edge's. [default: 0]
+    #[arg(long, value_name = "S", allow_negative_numbers = true)]
+    shift: Option<i32>,
 }
 
-fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
+/// The winged-edge scheme's options, resolved.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WingedEdgeOptions {
+    /// The edge band and the shared options.
+    pub edge: EdgeOptions,
+    /// 0: both wings half-length; 1: one full-length wing on the next edge; −1 on the
+    /// previous edge.
+    pub shift: i32,
+}
+
+impl Scheme for WingedEdge {
+    fn name(&self) -> &'static str {
+        "winged-edge"
+    }
+
+    fn about(&self) -> &'static str {
+        "quad-edge panels with wings along the neighbouring face edges"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        args_of::<WingedEdgeArgs>()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            face_scale: 0.5,
+            holes: 2,
+            holes_allowed: &[0, 1, 2, 4],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // As quad-edge: flaps and wings follow the neighbouring band edges.
+        true
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        let args: WingedEdgeArgs = values.parse()?;
+        let shift = args.shift.unwrap_or(0);
+        if !(-1..=1).contains(&shift) {
+            return Err(format!("--shift: {shift} must be -1, 0 or 1"));
+        }
+        Ok(Box::new(WingedEdgeOptions {
+            edge: args.band.resolve(panel)?,
+            shift,
+        }))
+    }
+}
+
+impl Configured for WingedEdgeOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.edge.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        Ok(panels(mesh, self))
+    }
+
+    fn params(&self) -> Params {
+        let mut params = self.edge.params();
+        params.push("shift", self.shift);
+        params
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
+
+/// Builds the winged edge panels of a mesh whose faces are planar and convex.
+pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
+    let shift = options.shift;
+    edge_scheme(mesh, &options.edge, |mesh, f, edge| {
+        face_flaps(mesh, f, edge, shift)
+    })
+}
+
+fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions, shift: i32) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
@@ -33,7 +128,6 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
     let inner = |k: usize| (1.0 - options.flap_scale) * at(k);
     let mid = |k: usize| 0.5 * (at(k) + at(k + 1));
     let inner_mid = |k: usize| 0.5 * (inner(k) + inner(k + 1));
-    let shift = options.shift;
 
     // The flap outline of edge k after B_k, B_k+1 (counter-clockwise).
     let rest: Vec<Vec<DVec2>> = (0..n)
@@ -87,7 +181,13 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         let centre = region.iter().copied().sum::<DVec2>() / region.len() as f64;
         // Pins along the band edge the region lies on.
         let along = region[1] - region[0];
-        let (pins, fewer) = place_pins(region, centre, along, options.holes, options.hole_diameter);
+        let (pins, fewer) = place_pins(
+            region,
+            centre,
+            along,
+            options.panel.holes,
+            options.panel.hole_diameter,
+        );
         short_at_corner[*corner] |= fewer;
         placed_at_corner[*corner] += pins.len();
         let connection = half_edges[*corner].0;
@@ -96,7 +196,7 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &SchemeOptions) -> FaceFlaps {
         }
     }
     parts.reduced = short_at_corner.iter().filter(|&&s| s).count();
-    parts.bare = if options.holes > 0 {
+    parts.bare = if options.panel.holes > 0 {
         placed_at_corner.iter().filter(|&&c| c == 0).count()
     } else {
         0

@@ -26,15 +26,148 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::{PanelLimit, SchemeError, SchemeOptions, SchemeOutput};
+use super::{args_of, fraction, Configured, OptionValues, PanelDefaults, PanelOptions};
+use super::{PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
-use crate::nest::shelf::{fits_rotated, smallest_box};
 use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{
-    clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, segment_distance,
+    clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, fits_rotated,
+    segment_distance, smallest_box,
 };
+use crate::record::{round4, Params};
+
+/// The woven scheme: plain-weaving ribbons from the extended graph rotation system.
+pub struct Woven;
+
+/// The woven options as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct WovenArgs {
+    /// Strand width: a strand's end covers this fraction of the face band's side,
+    /// below 1. [default: 0.4]
+    #[arg(long, value_name = "T")]
+    band_scale: Option<f64>,
+
+    /// Curl limit: a ribbon segment's convex hull is at most this many times its area.
+    /// Smaller cuts ribbons into more, straighter segments that nest on fewer sheets;
+    /// larger gives fewer joints. [default: 3]
+    #[arg(long, value_name = "R")]
+    curl_limit: Option<f64>,
+
+    /// Material thickness, with a unit: the two strands at a crossing are this far
+    /// apart, one lifted and one lowered by half of it; 0 for flat ribbons.
+    /// [default: 0.1in]
+    #[arg(long, value_name = "LENGTH")]
+    thickness: Option<String>,
+}
+
+/// The woven scheme's options, resolved (lengths in mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct WovenOptions {
+    /// The options every scheme takes.
+    pub panel: PanelOptions,
+    /// Strand width as a fraction of the band side.
+    pub band_scale: f64,
+    /// Material thickness (mm): strands cross this far apart.
+    pub thickness: f64,
+    /// A segment's convex hull is at most this many times its area: curling ribbons
+    /// are cut into pieces that nest.
+    pub curl_limit: f64,
+}
+
+impl Scheme for Woven {
+    fn name(&self) -> &'static str {
+        "woven"
+    }
+
+    fn about(&self) -> &'static str {
+        "plain-weaving ribbons from the extended graph rotation system"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        args_of::<WovenArgs>()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            // Below 1: the crossings lie between the face bands.
+            face_scale: 0.8,
+            holes: 2,
+            holes_allowed: &[0, 1, 2],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // A strand cuts each face corner between two band sides.
+        true
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        let args: WovenArgs = values.parse()?;
+        if panel.face_scale >= 1.0 {
+            return Err("--face-scale: woven needs a face scale below 1: the strands cross in the gap between the face bands".to_string());
+        }
+        let band_scale = fraction("band-scale", args.band_scale, 0.4)?;
+        if band_scale >= 1.0 {
+            return Err("--band-scale: woven needs a band scale below 1: a strand's end must stay clear of the band corner".to_string());
+        }
+        let curl_limit = args.curl_limit.unwrap_or(3.0);
+        if !(curl_limit.is_finite() && curl_limit >= 1.5) {
+            return Err(format!(
+                "--curl-limit: {curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"
+            ));
+        }
+        let text = args.thickness.as_deref().unwrap_or("0.1in");
+        let thickness =
+            crate::units::parse_length(text).map_err(|e| format!("--thickness: {e}"))?;
+        if !(thickness >= 0.0 && thickness.is_finite()) {
+            return Err(format!("--thickness: '{text}' must be zero or positive"));
+        }
+        // Material thicker than the sheet is wide is a typo (1e300mm would also
+        // overflow the ribbon geometry).
+        if let Some(limit) = panel.panel_limit {
+            let widest = limit.width.min(limit.height);
+            if thickness >= widest {
+                return Err(format!(
+                    "--thickness: '{text}' is not below the usable sheet's shorter side ({widest:.1} mm); it is the material's thickness"
+                ));
+            }
+        }
+        Ok(Box::new(WovenOptions {
+            panel,
+            band_scale,
+            thickness,
+            curl_limit,
+        }))
+    }
+}
+
+impl Configured for WovenOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        panels(mesh, self)
+    }
+
+    fn params(&self) -> Params {
+        let mut params = Params::default();
+        params.push("band_scale", self.band_scale);
+        params.push("thickness", round4(self.thickness));
+        params.push("curl_limit", self.curl_limit);
+        params
+    }
+
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+}
 
 /// Fraction of the band side (from the far corner) where a strand's end starts and
 /// ends, for band scale `t`.
@@ -178,6 +311,37 @@ pub struct CycleSummary {
     pub segments: usize,
 }
 
+/// The report's line about the cycles.
+fn cycle_report(cycles: &[CycleSummary]) -> Vec<String> {
+    let edges = cycles.iter().map(|c| c.edges);
+    let (lo, hi) = (edges.clone().min().unwrap_or(0), edges.max().unwrap_or(0));
+    // Rounded as the manifest has them, so the report's total is the manifest's.
+    let length: f64 = cycles.iter().map(|c| round4(c.length)).sum();
+    let segments: usize = cycles.iter().map(|c| c.segments).sum();
+    vec![format!(
+        "weave: {} cycles of {lo} to {hi} edges, {length:.0} mm of ribbon in all, cut into {segments} segments",
+        cycles.len()
+    )]
+}
+
+/// The manifest's `cycles` list: id, edges crossed, ribbon length (mm), segments.
+fn cycle_manifest(cycles: &[CycleSummary]) -> Params {
+    let list: Vec<Params> = cycles
+        .iter()
+        .map(|c| {
+            let mut entry = Params::default();
+            entry.push("id", format!("C{}", c.id));
+            entry.push("edges", c.edges);
+            entry.push("length", round4(c.length));
+            entry.push("segments", c.segments);
+            entry
+        })
+        .collect();
+    let mut manifest = Params::default();
+    manifest.push_records("cycles", list);
+    manifest
+}
+
 /// The printed id of a cycle.
 pub fn cycle_id(cycle: u32) -> Name {
     Name::Cycle(cycle + 1)
@@ -311,7 +475,7 @@ pub struct RibbonNotes {
 /// The ribbons of a closed mesh with every edge twisted, in cycle order.
 pub fn ribbons(
     mesh: &Mesh,
-    options: &SchemeOptions,
+    options: &WovenOptions,
 ) -> Result<(Vec<Ribbon>, RibbonNotes), SchemeError> {
     let cycles = trace_cycles(mesh, &vec![true; mesh.edge_count()])
         .map_err(|e| SchemeError::Weave(e.to_string()))?;
@@ -326,7 +490,7 @@ pub fn ribbons(
     let strands = Strands {
         mesh,
         centres: mesh.faces().map(|f| mesh.face_centre(f)).collect(),
-        scale: options.face_scale,
+        scale: options.panel.face_scale,
         lo,
         hi,
     };
@@ -720,10 +884,10 @@ fn plan_segments(ribbon: &Ribbon, limits: &Limits) -> Result<Vec<(usize, usize)>
 }
 
 /// Builds the woven panels: one per segment of every cycle's ribbon.
-pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, SchemeError> {
+pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, SchemeError> {
     let (ribbons, ribbon_notes) = ribbons(mesh, options)?;
     let limits = Limits {
-        panel: options.panel_limit,
+        panel: options.panel.panel_limit,
         curl: options.curl_limit,
     };
     let plans: Vec<Vec<(usize, usize)>> = ribbons
@@ -789,7 +953,8 @@ pub fn panels(mesh: &Mesh, options: &SchemeOptions) -> Result<SchemeOutput, Sche
         panels,
         connections: joint as usize,
         notes,
-        cycles,
+        report: cycle_report(&cycles),
+        manifest: cycle_manifest(&cycles),
     })
 }
 
@@ -803,7 +968,7 @@ fn segment_panel(
     len: usize,
     joints: [u32; 2],
     partners: [usize; 2],
-    options: &SchemeOptions,
+    options: &WovenOptions,
 ) -> (Panel, usize) {
     let ring = ribbon.pieces.len();
     let n = ribbon.edge_count();
@@ -850,7 +1015,7 @@ fn segment_panel(
         for (p, piece, local) in points {
             holes.push(Hole {
                 position: p,
-                diameter: options.hole_diameter,
+                diameter: options.panel.hole_diameter,
                 connection: joints[end],
                 facet: facet_index(piece, local) as u32,
             });
@@ -935,7 +1100,7 @@ fn strand_label(
     facet: usize,
     text: Name,
     kind: LabelKind,
-    options: &SchemeOptions,
+    options: &WovenOptions,
 ) -> Label {
     let pts = &ribbon.facet_points(k)[local];
     let centre = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
@@ -951,7 +1116,7 @@ fn strand_label(
         text,
         anchor: centre,
         direction,
-        height: options.label_height,
+        height: options.panel.label_height,
         facet: facet as u32,
         kind,
         on_edge: false,
@@ -966,9 +1131,9 @@ fn strand_label(
 fn joint_holes(
     ribbon: &Ribbon,
     ks: &[usize],
-    options: &SchemeOptions,
+    options: &WovenOptions,
 ) -> (Vec<(DVec3, usize, usize)>, bool) {
-    let wanted = options.holes as usize;
+    let wanted = options.panel.holes as usize;
     if wanted == 0 || ks.is_empty() {
         return (Vec::new(), false);
     }
@@ -989,7 +1154,7 @@ fn joint_holes(
     } else {
         &[1.0 / 3.0, 2.0 / 3.0]
     };
-    let radius = 0.5 * options.hole_diameter;
+    let radius = 0.5 * options.panel.hole_diameter;
     let mut points = Vec::new();
     let mut centres: Vec<DVec2> = Vec::new();
     for &f in fractions {

@@ -13,12 +13,12 @@ use glam::{DVec2, DVec3};
 use serde_json::Value;
 
 use super::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
-use unfold::config::{BuildOptions, Job, ModelOptions, SchemeName};
+use unfold::config::{BuildOptions, Job, ModelOptions};
 use unfold::flatten::{facet_frames, flatten};
 use unfold::mesh::split::SplitReport;
 use unfold::mesh::Mesh;
 use unfold::panel::{FacetFrame, FlatPanel, Panel};
-use unfold::scheme::{build_panels, SchemeOutput};
+use unfold::scheme::SchemeOutput;
 
 // =======================================================================================
 // Paths
@@ -458,11 +458,19 @@ pub fn check_output(
         .enumerate()
     {
         assert_eq!(count(entry, "sheet"), k + 1, "{what}: sheet numbers");
-        assert_eq!(
-            entry["file"].as_str(),
-            Some(file.as_str()),
-            "{what}: sheet file"
-        );
+        let files: Vec<&str> = entry["files"]
+            .as_array()
+            .expect("a sheet's files")
+            .iter()
+            .filter_map(Value::as_str)
+            .collect();
+        let stem = file.trim_end_matches(".svg");
+        let wanted: Vec<String> = ["svg", "dxf"]
+            .iter()
+            .map(|ext| format!("{stem}.{ext}"))
+            .filter(|name| out.join(name).is_file())
+            .collect();
+        assert_eq!(files, wanted, "{what}: the files of sheet {}", k + 1);
         assert_eq!(
             count(entry, "panels"),
             stats.panels,
@@ -554,7 +562,7 @@ pub fn pipeline(job: &Job) -> Pipeline {
     let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
     let unfold::run::SchemeMesh { mesh, split, .. } =
         unfold::run::scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh");
-    let output = build_panels(job.scheme, &mesh, &job.scheme_options).expect("scheme");
+    let output = job.scheme.build(&mesh).expect("scheme");
     let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
     let flat = panels
         .iter()
@@ -586,9 +594,9 @@ pub fn panels_of(job: &Job) -> (Mesh, usize, Vec<Panel>, Vec<FlatPanel>) {
 
 /// Build options for `scheme` at `--size size --holes holes --out out` (the rest at
 /// their defaults), to adjust before [`resolve`].
-pub fn options(scheme: SchemeName, size: &str, holes: u32, out: &Path) -> BuildOptions {
+pub fn options(scheme: &str, size: &str, holes: u32, out: &Path) -> BuildOptions {
     BuildOptions {
-        scheme: Some(scheme),
+        scheme: Some(scheme.to_string()),
         holes: Some(holes),
         out: Some(out.to_path_buf()),
         model: ModelOptions {
@@ -605,7 +613,7 @@ pub fn resolve(options: BuildOptions, model: &Path) -> Job {
 }
 
 /// The job of `unfold MODEL --scheme SCHEME --size SIZE --holes HOLES --out OUT`.
-pub fn job(scheme: SchemeName, model: &Path, size: &str, holes: u32, out: &Path) -> Job {
+pub fn job(scheme: &str, model: &Path, size: &str, holes: u32, out: &Path) -> Job {
     resolve(options(scheme, size, holes, out), model)
 }
 
