@@ -22,6 +22,7 @@ pub mod nest;
 pub mod panel;
 pub mod plane;
 pub mod record;
+pub mod rng;
 pub mod run;
 pub mod sanity;
 pub mod scheme;

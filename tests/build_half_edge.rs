@@ -749,6 +749,54 @@ fn output_folder_is_replaced_atomically() {
 // 8. --json and --quiet
 // =======================================================================================
 
+/// The manifest names the files each format wrote, sheet by sheet, and nothing else:
+/// `--format dxf` writes no SVG and its manifest names none.
+#[test]
+fn the_manifest_names_the_files_of_each_format() {
+    let tmp = TempDir::new().unwrap();
+    for (format, extensions) in [
+        ("svg", &["svg"][..]),
+        ("dxf", &["dxf"][..]),
+        ("svg,dxf", &["svg", "dxf"][..]),
+        ("dxf,svg", &["svg", "dxf"][..]),
+    ] {
+        let out = tmp.path().join(format.replace(',', "-"));
+        // genus2 at 300 mm lays out on two sheets.
+        let m = build(&model("genus2"), "300mm", &out, &["--format", format]);
+        let sheets = m["sheets"].as_array().unwrap();
+        assert!(sheets.len() >= 2, "{format}: several sheets");
+        let mut wanted: Vec<String> = Vec::new();
+        for (k, sheet) in sheets.iter().enumerate() {
+            let files: Vec<&str> = sheet["files"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|f| f.as_str().unwrap())
+                .collect();
+            let expected: Vec<String> = extensions
+                .iter()
+                .map(|ext| format!("genus2-{:02}.{ext}", k + 1))
+                .collect();
+            assert_eq!(files, expected, "--format {format}: sheet {}", k + 1);
+            wanted.extend(expected);
+        }
+        wanted.push("genus2-assembled.obj".into());
+        wanted.push("manifest.json".into());
+        let listed: Vec<&str> = m["files"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        assert_eq!(listed, wanted, "--format {format}: the manifest's files");
+        assert_eq!(
+            entry_names(&out),
+            wanted.iter().cloned().collect::<BTreeSet<String>>(),
+            "--format {format}: the folder"
+        );
+    }
+}
+
 #[test]
 fn json_summary_on_stdout() {
     let tmp = TempDir::new().unwrap();

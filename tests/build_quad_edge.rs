@@ -32,7 +32,7 @@ use common::build::{
 };
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
-use unfold::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
+use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use unfold::panel::{FlatPanel, Panel, Source};
 use unfold::scheme::edge_panel::EdgeOptions;
 
@@ -341,7 +341,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
         let along = (w - v).normalize();
 
         // The faces and the flap facet lying in each.
-        let mut flaps: Vec<(FaceId, HalfEdgeId, usize)> = Vec::new();
+        let mut flaps: Vec<(FaceId, HalfedgeId, usize)> = Vec::new();
         if mesh.is_boundary_edge(e) {
             let h = if mesh.face(h).is_some() { h } else { h.twin() };
             flaps.push((mesh.face(h).unwrap(), h, 0));
@@ -652,7 +652,7 @@ fn check_holes(
     let mut worst_apart = 0.0f64;
     let mut fewer = 0;
     for (&c, list) in &by_connection {
-        let h = HalfEdgeId(c);
+        let h = HalfedgeId(c);
         assert!(
             h.index() < mesh.half_edge_count(),
             "{what}: connection {c} is no half-edge"
@@ -740,7 +740,7 @@ fn check_holes(
             .collect();
         // Signed distance from the inner line of the band edge of half-edge `g`,
         // positive on the band edge's side.
-        let inner = |g: HalfEdgeId, q: DVec2| {
+        let inner = |g: HalfedgeId, q: DVec2| {
             let (bv, bw) = (
                 to2(band_corner(
                     mesh,

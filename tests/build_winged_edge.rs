@@ -87,7 +87,7 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
     let mesh = &p.mesh;
     let mut counts = BTreeMap::new();
     for (connection, panels) in &by_connection {
-        let h = unfold::mesh::HalfEdgeId(*connection);
+        let h = unfold::mesh::HalfedgeId(*connection);
         let expected: Vec<String> = {
             let mut ids = vec![
                 format!("E{}", h.edge().0),

@@ -18,7 +18,7 @@ use proptest::prelude::*;
 use proptest::test_runner::TestCaseError;
 
 use unfold::mesh::{
-    build_from_faces, build_mesh, prepare, read_model, FaceId, HalfEdgeId, Mesh, Polygons,
+    build_from_faces, build_mesh, prepare, read_model, FaceId, HalfedgeId, Mesh, Polygons,
     PrepareOptions, VertexId,
 };
 
@@ -339,7 +339,7 @@ fn face_sources(mesh: &Mesh, f: FaceId) -> Vec<u32> {
 
 /// The face's half-edges, walked by `next` with a step limit (a broken loop cannot hang
 /// the test), checking that every one of them belongs to the face.
-fn walk_face(mesh: &Mesh, f: FaceId) -> Result<Vec<HalfEdgeId>, TestCaseError> {
+fn walk_face(mesh: &Mesh, f: FaceId) -> Result<Vec<HalfedgeId>, TestCaseError> {
     let start = mesh.face_half_edge(f);
     let mut loop_ = vec![start];
     let mut h = mesh.next(start);
@@ -421,7 +421,7 @@ fn check_mesh(
         outgoing[mesh.origin(h).index()] += 1;
     }
     for v in mesh.vertices() {
-        let fan: Vec<HalfEdgeId> = mesh.vertex_outgoing(v).collect();
+        let fan: Vec<HalfedgeId> = mesh.vertex_outgoing(v).collect();
         prop_assert_eq!(fan.len(), outgoing[v.index()], "fan of {}", v);
         prop_assert!(fan.iter().all(|&h| mesh.origin(h) == v));
         prop_assert_eq!(

@@ -170,7 +170,7 @@ fn over_under_depends_on_orientation_not_on_the_start() {
     // in reverse order, so every walk starts elsewhere) and compare crossing by
     // crossing.
     type CornerKey = (u32, u32, u32);
-    let corner_key = |mesh: &Mesh, c: unfold::mesh::HalfEdgeId| -> CornerKey {
+    let corner_key = |mesh: &Mesh, c: unfold::mesh::HalfedgeId| -> CornerKey {
         // The corner at dest(c) between c and next(c): its vertex and its two
         // neighbours in the face identify it on a manifold mesh.
         let w = mesh.vertex_source(mesh.dest(c));

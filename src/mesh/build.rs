@@ -4,7 +4,7 @@
 use glam::DVec3;
 
 use super::halfedge::{Mesh, NO_FACE};
-use super::ids::{HalfEdgeId, VertexId};
+use super::ids::{HalfedgeId, VertexId};
 use super::polygons::Polygons;
 use super::soup::{corner_edge, corner_fans, CornerEdges};
 
@@ -133,23 +133,23 @@ pub fn build_mesh(
     drop(corners);
 
     let mut edge_of_group = vec![u32::MAX; group_count as usize];
-    let mut corner_half_edge = vec![HalfEdgeId(0); corner_count];
+    let mut corner_half_edge = vec![HalfedgeId(0); corner_count];
     let mut edge_count = 0u32;
     for (c, &g) in group_of_corner.iter().enumerate() {
         let slot = &mut edge_of_group[g as usize];
         corner_half_edge[c] = if *slot == u32::MAX {
             *slot = edge_count;
             edge_count += 1;
-            HalfEdgeId(2 * *slot)
+            HalfedgeId(2 * *slot)
         } else {
-            HalfEdgeId(2 * *slot + 1)
+            HalfedgeId(2 * *slot + 1)
         };
     }
     drop(group_of_corner);
     drop(edge_of_group);
 
     let half_edge_count = 2 * edge_count as usize;
-    let unset = HalfEdgeId(u32::MAX);
+    let unset = HalfedgeId(u32::MAX);
     let mut next = vec![unset; half_edge_count];
     let mut prev = vec![unset; half_edge_count];
     let mut face_of = vec![NO_FACE; half_edge_count];
@@ -162,7 +162,7 @@ pub fn build_mesh(
             let n = if c + 1 == end { start } else { c + 1 };
             let hn = corner_half_edge[n];
             next[h] = hn;
-            prev[hn.index()] = HalfEdgeId(h as u32);
+            prev[hn.index()] = HalfedgeId(h as u32);
             face_of[h] = f as u32;
         }
     }
@@ -206,25 +206,25 @@ pub fn build_mesh(
     let mut boundary_out = vec![unset; vertex_count];
     for h in 0..half_edge_count {
         if face_of[h] == NO_FACE {
-            let interior = HalfEdgeId(h as u32).twin();
+            let interior = HalfedgeId(h as u32).twin();
             let o = origin[next[interior.index()].index()];
             origin[h] = o;
-            boundary_out[o.index()] = HalfEdgeId(h as u32);
+            boundary_out[o.index()] = HalfedgeId(h as u32);
         }
     }
     for h in 0..half_edge_count {
         if face_of[h] == NO_FACE {
-            let head = origin[HalfEdgeId(h as u32).twin().index()];
+            let head = origin[HalfedgeId(h as u32).twin().index()];
             let n = boundary_out[head.index()];
             next[h] = n;
-            prev[n.index()] = HalfEdgeId(h as u32);
+            prev[n.index()] = HalfedgeId(h as u32);
         }
     }
 
     let mut vertex_half_edge = vec![unset; vertex_count];
     for h in (0..half_edge_count).rev() {
         // Reverse order so the lowest outgoing half-edge wins for interior vertices.
-        vertex_half_edge[origin[h].index()] = HalfEdgeId(h as u32);
+        vertex_half_edge[origin[h].index()] = HalfedgeId(h as u32);
     }
     for (v, &b) in boundary_out.iter().enumerate() {
         if b != unset {

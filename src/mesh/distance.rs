@@ -243,7 +243,7 @@ mod tests {
             }
         }
         let grid = TriangleGrid::new(&triangles);
-        let mut rng = crate::nest::rng::SplitMix64::new(7);
+        let mut rng = crate::rng::SplitMix64::new(7);
         let mut unit = || rng.unit();
         for _ in 0..300 {
             let p = DVec3::new(unit() * 14.0 - 2.0, unit() * 14.0 - 2.0, unit() * 6.0 - 3.0);

@@ -11,7 +11,7 @@
 //! face half-edge that ends there: h for a left step, `prev(twin(h))` for a right one.
 
 use super::halfedge::Mesh;
-use super::ids::{EdgeId, HalfEdgeId};
+use super::ids::{EdgeId, HalfedgeId};
 
 /// Which face a step follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -35,11 +35,11 @@ impl Side {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct WeaveCycle {
     /// The darts walked, in order.
-    pub darts: Vec<HalfEdgeId>,
+    pub darts: Vec<HalfedgeId>,
     /// The side of the step after each dart.
     pub sides: Vec<Side>,
     /// The face corner passed after each dart (the face half-edge ending there).
-    pub corners: Vec<HalfEdgeId>,
+    pub corners: Vec<HalfedgeId>,
     /// At each dart's edge: `Some(true)` where the thread goes over, `Some(false)`
     /// under, `None` where the edge is not twisted (the thread runs beside it).
     pub over: Vec<Option<bool>>,

@@ -13,7 +13,7 @@
 
 use glam::DVec3;
 
-use super::ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
+use super::ids::{EdgeId, FaceId, HalfedgeId, VertexId};
 
 /// Marks "no face" in the half-edge → face table (boundary half-edges).
 pub(crate) const NO_FACE: u32 = u32::MAX;
@@ -25,12 +25,12 @@ pub(crate) const NO_FACE: u32 = u32::MAX;
 #[derive(Clone, Debug)]
 pub struct Mesh {
     pub(crate) positions: Vec<DVec3>,
-    pub(crate) vertex_half_edge: Vec<HalfEdgeId>,
-    pub(crate) half_edge_next: Vec<HalfEdgeId>,
-    pub(crate) half_edge_prev: Vec<HalfEdgeId>,
+    pub(crate) vertex_half_edge: Vec<HalfedgeId>,
+    pub(crate) half_edge_next: Vec<HalfedgeId>,
+    pub(crate) half_edge_prev: Vec<HalfedgeId>,
     pub(crate) half_edge_origin: Vec<VertexId>,
     pub(crate) half_edge_face: Vec<u32>,
-    pub(crate) face_half_edge: Vec<HalfEdgeId>,
+    pub(crate) face_half_edge: Vec<HalfedgeId>,
     pub(crate) vertex_source: Vec<u32>,
     pub(crate) face_source: Vec<u32>,
 }
@@ -62,8 +62,8 @@ impl Mesh {
     }
 
     /// All half-edge handles in index order.
-    pub fn half_edges(&self) -> impl ExactSizeIterator<Item = HalfEdgeId> {
-        (0..self.half_edge_count() as u32).map(HalfEdgeId)
+    pub fn half_edges(&self) -> impl ExactSizeIterator<Item = HalfedgeId> {
+        (0..self.half_edge_count() as u32).map(HalfedgeId)
     }
 
     /// All edge handles in index order.
@@ -120,37 +120,37 @@ impl Mesh {
 
     /// The opposite half-edge.
     #[inline]
-    pub fn twin(&self, h: HalfEdgeId) -> HalfEdgeId {
+    pub fn twin(&self, h: HalfedgeId) -> HalfedgeId {
         h.twin()
     }
 
     /// The next half-edge around the face (or boundary loop).
     #[inline]
-    pub fn next(&self, h: HalfEdgeId) -> HalfEdgeId {
+    pub fn next(&self, h: HalfedgeId) -> HalfedgeId {
         self.half_edge_next[h.index()]
     }
 
     /// The previous half-edge around the face (or boundary loop).
     #[inline]
-    pub fn prev(&self, h: HalfEdgeId) -> HalfEdgeId {
+    pub fn prev(&self, h: HalfedgeId) -> HalfedgeId {
         self.half_edge_prev[h.index()]
     }
 
     /// The vertex a half-edge starts at.
     #[inline]
-    pub fn origin(&self, h: HalfEdgeId) -> VertexId {
+    pub fn origin(&self, h: HalfedgeId) -> VertexId {
         self.half_edge_origin[h.index()]
     }
 
     /// The vertex a half-edge ends at.
     #[inline]
-    pub fn dest(&self, h: HalfEdgeId) -> VertexId {
+    pub fn dest(&self, h: HalfedgeId) -> VertexId {
         self.origin(h.twin())
     }
 
     /// The face to the left of a half-edge, `None` on the boundary.
     #[inline]
-    pub fn face(&self, h: HalfEdgeId) -> Option<FaceId> {
+    pub fn face(&self, h: HalfedgeId) -> Option<FaceId> {
         match self.half_edge_face[h.index()] {
             NO_FACE => None,
             f => Some(FaceId(f)),
@@ -159,7 +159,7 @@ impl Mesh {
 
     /// True for half-edges without a face (they run along holes).
     #[inline]
-    pub fn is_boundary_half_edge(&self, h: HalfEdgeId) -> bool {
+    pub fn is_boundary_half_edge(&self, h: HalfedgeId) -> bool {
         self.half_edge_face[h.index()] == NO_FACE
     }
 
@@ -178,13 +178,13 @@ impl Mesh {
 
     /// One outgoing half-edge of a vertex (the boundary one for boundary vertices).
     #[inline]
-    pub fn vertex_half_edge(&self, v: VertexId) -> HalfEdgeId {
+    pub fn vertex_half_edge(&self, v: VertexId) -> HalfedgeId {
         self.vertex_half_edge[v.index()]
     }
 
     /// One half-edge of a face.
     #[inline]
-    pub fn face_half_edge(&self, f: FaceId) -> HalfEdgeId {
+    pub fn face_half_edge(&self, f: FaceId) -> HalfedgeId {
         self.face_half_edge[f.index()]
     }
 
@@ -206,7 +206,7 @@ impl Mesh {
     }
 
     /// The half-edges of the loop (face or boundary) that `start` belongs to.
-    pub fn loop_from(&self, start: HalfEdgeId) -> LoopIter<'_> {
+    pub fn loop_from(&self, start: HalfedgeId) -> LoopIter<'_> {
         LoopIter {
             mesh: self,
             start,
@@ -281,14 +281,14 @@ impl Mesh {
 /// after as many steps as there are half-edges, so a corrupt mesh cannot hang a walk.
 pub struct LoopIter<'a> {
     mesh: &'a Mesh,
-    start: HalfEdgeId,
-    current: Option<HalfEdgeId>,
+    start: HalfedgeId,
+    current: Option<HalfedgeId>,
     steps_left: usize,
 }
 
 impl Iterator for LoopIter<'_> {
-    type Item = HalfEdgeId;
-    fn next(&mut self) -> Option<HalfEdgeId> {
+    type Item = HalfedgeId;
+    fn next(&mut self) -> Option<HalfedgeId> {
         let h = self.current?;
         let n = self.mesh.next(h);
         self.steps_left = self.steps_left.saturating_sub(1);
@@ -301,14 +301,14 @@ impl Iterator for LoopIter<'_> {
 /// `next(twin(h))`. Like [`LoopIter`], bounded by the half-edge count.
 pub struct VertexIter<'a> {
     mesh: &'a Mesh,
-    start: HalfEdgeId,
-    current: Option<HalfEdgeId>,
+    start: HalfedgeId,
+    current: Option<HalfedgeId>,
     steps_left: usize,
 }
 
 impl Iterator for VertexIter<'_> {
-    type Item = HalfEdgeId;
-    fn next(&mut self) -> Option<HalfEdgeId> {
+    type Item = HalfedgeId;
+    fn next(&mut self) -> Option<HalfedgeId> {
         let h = self.current?;
         let n = self.mesh.next(h.twin());
         self.steps_left = self.steps_left.saturating_sub(1);

@@ -51,7 +51,7 @@ handle!(
 handle!(
     /// A directed half-edge. Half-edges come in pairs: the twin of `h` is `h ^ 1` and
     /// its edge is `h / 2`, so twin links cannot drift out of step.
-    HalfEdgeId,
+    HalfedgeId,
     "h"
 );
 handle!(
@@ -65,11 +65,11 @@ handle!(
     "f"
 );
 
-impl HalfEdgeId {
+impl HalfedgeId {
     /// The opposite half-edge of the same edge.
     #[inline]
-    pub fn twin(self) -> HalfEdgeId {
-        HalfEdgeId(self.0 ^ 1)
+    pub fn twin(self) -> HalfedgeId {
+        HalfedgeId(self.0 ^ 1)
     }
 
     /// The undirected edge this half-edge belongs to.
@@ -82,7 +82,7 @@ impl HalfEdgeId {
 impl EdgeId {
     /// The first half-edge of the edge (`2e`); its twin is `2e + 1`.
     #[inline]
-    pub fn half_edge(self) -> HalfEdgeId {
-        HalfEdgeId(self.0 << 1)
+    pub fn half_edge(self) -> HalfedgeId {
+        HalfedgeId(self.0 << 1)
     }
 }

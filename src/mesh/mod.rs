@@ -25,7 +25,7 @@ pub mod weld;
 
 pub use build::{build_from_faces, build_mesh, BuildError, BuildReport};
 pub use halfedge::Mesh;
-pub use ids::{EdgeId, FaceId, HalfEdgeId, VertexId};
+pub use ids::{EdgeId, FaceId, HalfedgeId, VertexId};
 pub use polygons::Polygons;
 pub use prepare::{prepare, Note, PrepareOptions, PreparedModel};
 pub use read::{parse_model, read_model, Format, RawModel};

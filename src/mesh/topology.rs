@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::geometry::planarity_error;
 use super::halfedge::Mesh;
-use super::ids::{FaceId, HalfEdgeId};
+use super::ids::{FaceId, HalfedgeId};
 
 /// Facts of one connected component.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -121,7 +121,7 @@ impl Mesh {
     }
 
     /// One boundary half-edge of every boundary loop, in index order.
-    pub fn boundary_loops(&self) -> Vec<HalfEdgeId> {
+    pub fn boundary_loops(&self) -> Vec<HalfedgeId> {
         let mut seen = vec![false; self.half_edge_count()];
         let mut loops = Vec::new();
         for h in self.half_edges() {
@@ -151,7 +151,7 @@ impl Mesh {
                 first_face: u32::MAX,
             })
             .collect();
-        let component_of_half_edge = |h: HalfEdgeId| {
+        let component_of_half_edge = |h: HalfedgeId| {
             let f = self.face(h).or_else(|| self.face(h.twin()));
             f.map(|f| component_of_face[f.index()] as usize)
         };

@@ -1,7 +1,7 @@
 //! Connectivity invariants of the half-edge mesh, checked one rule at a time.
 
 use super::halfedge::{Mesh, NO_FACE};
-use super::ids::{FaceId, HalfEdgeId, VertexId};
+use super::ids::{FaceId, HalfedgeId, VertexId};
 
 /// The first broken rule found by [`Mesh::validate`]. Each variant is one invariant,
 /// so a test (or a bug report) says exactly what went wrong.
@@ -15,23 +15,23 @@ pub enum ConnectivityError {
     OutOfRange { what: &'static str, at: String },
     /// `next(prev(h)) != h` or `prev(next(h)) != h`.
     #[error("next and prev disagree at {0}")]
-    NextPrev(HalfEdgeId),
+    NextPrev(HalfedgeId),
     /// A half-edge and its twin start at the same vertex, or `next(h)` does not start
     /// where `h` ends.
     #[error("half-edge {0} does not connect head to tail with its neighbours")]
-    Endpoints(HalfEdgeId),
+    Endpoints(HalfedgeId),
     /// A face loop does not close within the half-edge count, or mixes faces.
     #[error("the loop of face {0} does not close on itself")]
     FaceLoop(FaceId),
     /// An edge with no face on either side.
     #[error("edge of half-edge {0} has no face on either side")]
-    FacelessEdge(HalfEdgeId),
+    FacelessEdge(HalfedgeId),
     /// A vertex's stored half-edge does not start at it.
     #[error("the stored half-edge of {0} does not start there")]
-    VertexHalfEdge(VertexId),
+    VertexHalfedge(VertexId),
     /// A boundary vertex whose stored half-edge is not its boundary half-edge.
     #[error("boundary vertex {0} does not store its boundary half-edge")]
-    BoundaryVertexHalfEdge(VertexId),
+    BoundaryVertexHalfedge(VertexId),
     /// Turning around a vertex does not visit all its outgoing half-edges (a bow-tie).
     #[error("vertex {0} has more than one fan of faces")]
     NonManifoldVertex(VertexId),
@@ -138,13 +138,13 @@ impl Mesh {
         for v in self.vertices() {
             let start = self.vertex_half_edge(v);
             if self.origin(start) != v {
-                return Err(E::VertexHalfEdge(v));
+                return Err(E::VertexHalfedge(v));
             }
             if boundary_out[v.index()] > 1 {
                 return Err(E::NonManifoldVertex(v));
             }
             if boundary_out[v.index()] == 1 && !self.is_boundary_half_edge(start) {
-                return Err(E::BoundaryVertexHalfEdge(v));
+                return Err(E::BoundaryVertexHalfedge(v));
             }
             let mut turned = 0u32;
             let mut h = start;

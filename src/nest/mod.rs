@@ -5,7 +5,6 @@
 //! exporters flip y for SVG).
 
 pub mod grid;
-pub mod rng;
 pub mod shelf;
 pub mod true_shape;
 

@@ -48,9 +48,9 @@ mod rows;
 mod separate;
 
 use super::grid::Grid;
-use super::rng::SplitMix64;
 use super::{Layout, Placement, SheetSpec, TooLarge};
 use crate::plane::{bounds, convex_hull, offset_outline};
+use crate::rng::SplitMix64;
 
 /// Search settings of the true-shape nester.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::{face_band, fraction, PanelOptions};
-use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
+use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
 use crate::record::Params;
@@ -229,7 +229,7 @@ pub fn band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> (Vec<DVec3>, Vec<D
 }
 
 /// The half-edges of a face in loop order (corner k is the origin of the k-th).
-pub fn corner_half_edges(mesh: &Mesh, f: FaceId) -> Vec<HalfEdgeId> {
+pub fn corner_half_edges(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
     mesh.face_half_edges(f).collect()
 }
 
@@ -474,7 +474,7 @@ fn flap_labels(
     mesh: &Mesh,
     part: &FaceFlaps,
     face: FaceId,
-    he: HalfEdgeId,
+    he: HalfedgeId,
     corner: usize,
     facet: u32,
     options: &EdgeOptions,

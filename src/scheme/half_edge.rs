@@ -14,7 +14,7 @@ use super::{
     args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
     SchemeOutput,
 };
-use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh};
+use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 use crate::record::{round4, Params};
@@ -24,7 +24,7 @@ use crate::record::{round4, Params};
 #[derive(Clone, Debug)]
 struct Tab {
     /// Owner half-edge (a → b in the owner face).
-    owner: HalfEdgeId,
+    owner: HalfedgeId,
     /// Base points on the edge: a' near a, b' near b.
     base: [DVec3; 2],
     /// The tab outline after b', a' (so the tab facet is b', a', top…).
@@ -266,14 +266,14 @@ fn face_panel(
         vertices.push(p);
         (vertices.len() - 1) as u32
     };
-    let half_edges: Vec<HalfEdgeId> = mesh.face_half_edges(f).collect();
+    let half_edges: Vec<HalfedgeId> = mesh.face_half_edges(f).collect();
     let n = half_edges.len();
     let mut band_facet: Vec<u32> = Vec::with_capacity(n + 4);
     let mut extra_facets: Vec<Vec<u32>> = Vec::new();
     let mut holes = Vec::new();
     let mut labels = Vec::new();
     // Facet 0 is the band; tab facets follow (indices known once pushed).
-    let tab_of = |h: HalfEdgeId| tabs.of_edge(h.edge());
+    let tab_of = |h: HalfedgeId| tabs.of_edge(h.edge());
     let mut pending_tabs: Vec<(&Tab, u32, u32)> = Vec::new();
     // With s < 1, the mesh corners where bridges meet: one vertex per corner, shared by
     // the bridges on both sides so that their common side is a (flat) hinge, not a
@@ -384,7 +384,7 @@ fn face_panel(
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
 /// `None` when the neighbour cannot hold one.
-fn make_tab(mesh: &Mesh, owner: HalfEdgeId, options: &HalfEdgeOptions) -> Option<Tab> {
+fn make_tab(mesh: &Mesh, owner: HalfedgeId, options: &HalfEdgeOptions) -> Option<Tab> {
     let g = mesh.face(owner.twin())?;
     let (a, b) = (
         mesh.position(mesh.origin(owner)),

@@ -30,7 +30,7 @@ use super::{args_of, fraction, Configured, OptionValues, PanelDefaults, PanelOpt
 use super::{PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
-use crate::mesh::{EdgeId, FaceId, HalfEdgeId, Mesh, VertexId};
+use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
 use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{
     clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, fits_rotated,
@@ -200,7 +200,7 @@ pub enum PieceKind {
     /// landing (at one end's height) or the turn between the two heights.
     Face {
         /// The face half-edge ending at the corner.
-        corner: HalfEdgeId,
+        corner: HalfedgeId,
     },
     /// Across an edge.
     Edge {
@@ -380,7 +380,7 @@ impl Strands<'_> {
     }
 
     /// The strand region at the corner ending face half-edge `c`, in its face plane.
-    fn region(&self, c: HalfEdgeId) -> [DVec3; 4] {
+    fn region(&self, c: HalfedgeId) -> [DVec3; 4] {
         let f = self.mesh.face(c).expect("a face half-edge");
         let w = self.mesh.dest(c);
         let a = self.end(f, w, self.mesh.origin(c));
@@ -389,7 +389,7 @@ impl Strands<'_> {
     }
 
     /// The face half-edge of `f` ending at `v`.
-    fn corner_at(&self, f: FaceId, v: VertexId) -> HalfEdgeId {
+    fn corner_at(&self, f: FaceId, v: VertexId) -> HalfedgeId {
         self.mesh
             .face_half_edges(f)
             .find(|&h| self.mesh.dest(h) == v)
@@ -408,7 +408,7 @@ fn landings(
     f: FaceId,
     entry: [DVec3; 2],
     exit: [DVec3; 2],
-    neighbours: [HalfEdgeId; 2],
+    neighbours: [HalfedgeId; 2],
 ) -> ([f64; 2], bool) {
     let n = strands.mesh.face_normal(f);
     let x = n.any_orthonormal_vector();
@@ -521,7 +521,7 @@ pub fn ribbons(
             // off the edge pieces' plane (both strands' edge pieces stay parallel,
             // the thickness apart).
             let face_normal = mesh.face_normal(f);
-            let lift = |dart: HalfEdgeId, over: Option<bool>| {
+            let lift = |dart: HalfedgeId, over: Option<bool>| {
                 let sign = if over.unwrap_or(true) { 1.0 } else { -1.0 };
                 let m = normals[dart.edge().index()];
                 sign * half / face_normal.dot(m).max(MIN_LIFT_COSINE) * face_normal

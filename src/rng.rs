@@ -1,5 +1,5 @@
-//! A small seeded generator (SplitMix64): the nester's only source of randomness, so a
-//! seed fixes the layout on every platform.
+//! A small seeded generator (SplitMix64): the nester's only source of randomness (and
+//! the tests'), so a seed fixes the layout on every platform.
 
 /// SplitMix64 (Steele, Lea and Flood 2014): 64 bits of state, passes BigCrush.
 #[derive(Clone, Debug)]
