@@ -31,9 +31,10 @@ fn job(model: &Path, scheme: &str, size: &str) -> Job {
 
 /// The mesh the scheme works on (loaded, prepared, scaled and split).
 fn scheme_mesh(job: &Job) -> Mesh {
-    let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
-    unfold::run::scheme_mesh(job, &raw, prepared.mesh)
+    let loaded = unfold::run::load(job).expect("model loads");
+    unfold::run::prepare(job, loaded)
         .expect("scheme mesh")
+        .scheme_mesh
         .mesh
 }
 

@@ -12,8 +12,6 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use unfold::config::{BuildOptions, ModelOptions};
-use unfold::flatten::unroll_all;
-use unfold::labels::LabelOptions;
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -48,18 +46,15 @@ fn main() -> anyhow::Result<()> {
         );
         last = now;
     };
-    let (raw, prepared) = unfold::load_model(&model, &job.model)?;
-    let faces = prepared.mesh.face_count();
+    let loaded = unfold::run::load(&job)?;
+    let faces = loaded.prepared.mesh.face_count();
     lap("load");
-    let scheme_mesh = unfold::run::scheme_mesh(&job, &raw, prepared.mesh)?;
-    drop(raw);
+    let prepared = unfold::run::prepare(&job, loaded)?;
     lap("split");
-    let output = job.scheme.build(&scheme_mesh.mesh)?;
-    // As the pipeline does (memory.rs).
-    unfold::memory::release_freed();
+    let output = unfold::run::scheme(&job, &prepared)?;
     lap("scheme");
     // The pipeline's flatten stage: unrolling and label fitting.
-    let (flat, _) = unroll_all(&output.panels, LabelOptions::default())?;
+    let flat = unfold::run::flatten(&job, &prepared, &output)?.panels;
     lap("flatten");
     let total = start.elapsed().as_secs_f64();
     let per_panel = |count: &dyn Fn(unfold::panel::PanelRef) -> usize| {

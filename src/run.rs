@@ -1,6 +1,8 @@
-//! The whole pipeline for one job: read → prepare → scale → split → scheme → flatten →
-//! labels → layout → export. Each stage is a call into its module; this file only
-//! composes them, times them and turns their failures into [`Error`]s.
+//! The pipeline for one job as named stages, each returning a plain struct the next
+//! takes: [`load`] (read, repair, simplify) → [`prepare`] (scale, split, size checks)
+//! → [`scheme`] → [`flatten`] (unroll, fit labels) → [`nest`] → [`export`] (sheets in
+//! every format, the manifest). [`run_observed`] composes them, times them and writes
+//! the output folder; the tests, benches and examples call the same stages.
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -22,6 +24,7 @@ use crate::mesh::FaceId;
 use crate::nest::{lay_out, Layout, SheetSpec};
 use crate::panel::{FlatPanelRef, FlatPanels, Source};
 use crate::plane::is_simple;
+use crate::scheme::SchemeOutput;
 
 /// What a finished run produced.
 #[derive(Clone, Debug)]
@@ -154,32 +157,70 @@ pub fn planarize_faces(
     })
 }
 
-/// Runs a job and writes its output folder (replaced whole by a swap, so on any error
-/// the folder is left as it was; see [`crate::export::folder`] for the cases written
-/// in place).
-pub fn run(job: &Job) -> Result<Outcome> {
-    run_observed(job, &mut |_| {})
+/// The model as read and prepared (repairs, simplification), in model units.
+pub struct Loaded {
+    /// The file as read, for messages that point at its lines.
+    pub raw: crate::mesh::RawModel,
+    /// The prepared mesh and the notes of its repairs.
+    pub prepared: crate::mesh::PreparedModel,
 }
 
-/// [`run`], handing each warning about the build to `warn` as soon as it is known
-/// (before the long stages), so a user can stop a build that is not what they meant.
-pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
-    let mut clock = Stopwatch::new();
-    // Refused before the long stages: a folder given as the model, and an output
-    // folder that holds files unfold did not write.
-    crate::mesh::read::model_format(&job.model_path)?;
-    let folder = check_output_folder(&job.out, &job.model_path, job.force)?;
-    let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
-    let mut notes: Vec<String> = prepared.notes.iter().map(|n| n.message.clone()).collect();
-    clock.lap("load");
+/// The mesh the scheme builds, in millimetres, and what was found on the way.
+pub struct Prepared {
+    /// Scaled, split (and planarized) as the scheme needs.
+    pub scheme_mesh: SchemeMesh,
+    /// Its topology, for the manifest.
+    pub topology: crate::mesh::Topology,
+    /// Observations for the report (repairs, split faces, planarization).
+    pub notes: Vec<String>,
+    /// Findings about the build's size, each naming its fix.
+    pub warnings: Vec<String>,
+}
 
-    let SchemeMesh {
-        mesh,
-        split,
-        mm_per_unit,
-        planarized,
-    } = scheme_mesh(job, &raw, prepared.mesh)?;
-    if let Some(report) = planarized.filter(|r| r.non_planar_before > 0) {
+/// The flat panels with their labels fitted.
+pub struct Flat {
+    /// The panels, unrolled, in the scheme's order.
+    pub panels: FlatPanels,
+    /// Labels left out for want of room.
+    pub labels_left_out: LeftOut,
+    /// The finding when too many panel ids were left out.
+    pub warning: Option<String>,
+}
+
+/// The panels laid out on sheets.
+pub struct Nested {
+    /// Where each panel lies.
+    pub layout: Layout,
+    /// The search as the manifest records it.
+    pub nesting: manifest::Nesting,
+    /// Sheets the panel area needs counting the spacing.
+    pub spacing_bound: usize,
+    /// Observations for the report.
+    pub notes: Vec<String>,
+}
+
+/// Stage 1, load: reads and prepares the model.
+pub fn load(job: &Job) -> Result<Loaded> {
+    let (raw, prepared) = crate::load_model(&job.model_path, &job.model)?;
+    Ok(Loaded { raw, prepared })
+}
+
+/// Stage 2, prepare: scales to millimetres, splits (or planarizes) the faces the
+/// scheme cannot build, and checks the build's size (an error under `--strict`).
+pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
+    let mut notes: Vec<String> = loaded
+        .prepared
+        .notes
+        .iter()
+        .map(|n| n.message.clone())
+        .collect();
+    let scheme_mesh = scheme_mesh(job, &loaded.raw, loaded.prepared.mesh)?;
+    let split = &scheme_mesh.split;
+    if let Some(report) = scheme_mesh
+        .planarized
+        .as_ref()
+        .filter(|r| r.non_planar_before > 0)
+    {
         notes.push(format!(
             "planarized {} non-planar faces (of {} with four or more corners) in {} iterations: largest planarity error {:.2e} -> {:.2e}, largest vertex move {:.3} mm",
             report.non_planar_before,
@@ -203,14 +244,19 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             split.not_star_shaped.len()
         ));
     }
-    let mut size_check = crate::sanity::check_size(job, &mesh)?;
-    for warning in &size_check.warnings {
-        warn(warning);
-    }
-    let topology = mesh.topology();
-    clock.lap("split");
+    let warnings = crate::sanity::check_size(job, &scheme_mesh.mesh)?.warnings;
+    let topology = scheme_mesh.mesh.topology();
+    Ok(Prepared {
+        scheme_mesh,
+        topology,
+        notes,
+        warnings,
+    })
+}
 
-    let output = job.scheme.build(&mesh).map_err(|e| {
+/// Stage 3, scheme: the job's scheme builds the 3D panels.
+pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
+    let output = job.scheme.build(&prepared.scheme_mesh.mesh).map_err(|e| {
         let message = format!("{}: {e}", job.model_path.display());
         if e.is_usage() {
             Error::Usage(message)
@@ -218,16 +264,17 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             Error::Runtime(message)
         }
     })?;
-    notes.extend(output.notes.iter().cloned());
     crate::memory::release_freed();
-    clock.lap("scheme");
+    Ok(output)
+}
 
+/// Stage 4, flatten: unrolls every panel and fits its labels; a panel that overlaps
+/// itself is an error naming it.
+pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<Flat> {
+    let mesh = &prepared.scheme_mesh.mesh;
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
         .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
-    if let Some(warning) = crate::sanity::check_labels(job, &mesh, flat.len(), &labels_left_out)? {
-        warn(&warning);
-        size_check.warnings.push(warning);
-    }
+    let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out)?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
         // is a projection of a warped polygon.
@@ -250,8 +297,16 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             bad.id()
         )));
     }
-    clock.lap("flatten");
+    Ok(Flat {
+        panels: flat,
+        labels_left_out,
+        warning,
+    })
+}
 
+/// Stage 5, nest: lays the flat panels out on sheets.
+pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
+    let flat = &flat.panels;
     let sheet = SheetSpec {
         width: job.sheet.width,
         height: job.sheet.height,
@@ -267,6 +322,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     };
     let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
     let nested = lay_out(&outlines, &areas, sheet, &job.nest).map_err(too_large)?;
+    let mut notes = Vec::new();
     if let Some(searched) = nested.dropped_search_sheets {
         notes.push(format!(
             "the true-shape search needed {searched} sheets and the shelf layout {}: the shelf layout is used",
@@ -283,16 +339,41 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         time_limit: search.time_limit.map(|t| t.as_secs_f64()),
         shelf_sheets: nested.shelf_sheets,
     };
-    let spacing_bound = nested.spacing_bound;
-    let layout = nested.layout;
-    clock.lap("nest");
+    Ok(Nested {
+        layout: nested.layout,
+        nesting,
+        spacing_bound: nested.spacing_bound,
+        notes,
+    })
+}
 
+/// The files of a run and its manifest.
+pub struct Exported {
+    /// Name and bytes of every file, the manifest last.
+    pub files: Vec<(String, Vec<u8>)>,
+    /// The manifest (also the last file).
+    pub manifest: Manifest,
+}
+
+/// Stage 6, export: draws every sheet in every format and builds the manifest: the
+/// output folder's files, which [`run_observed`] writes.
+pub fn export(
+    job: &Job,
+    prepared: &Prepared,
+    output: &SchemeOutput,
+    flat: &Flat,
+    nested: &Nested,
+    warnings: Vec<String>,
+) -> Result<Exported> {
+    let layout = &nested.layout;
+    let panels = &flat.panels;
     let name = job
         .model_path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "model".into());
     let digits = layout.sheets.to_string().len().max(2);
+    let sheet = layout.sheet;
     // Sheets are independent: drawn in parallel, collected in sheet order.
     let drawn: Vec<DrawnSheet> = (0..layout.sheets)
         .into_par_iter()
@@ -304,17 +385,17 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
                 .map(|format| {
                     (
                         format!("{stem}.{}", format.extension()),
-                        format.write_sheet(&layout, index, &flat, job.stroke_width),
+                        format.write_sheet(layout, index, panels, job.stroke_width),
                     )
                 })
                 .collect();
             let mut lengths = Lengths::default();
-            draw_sheet(&layout, index, &flat, &mut lengths);
+            draw_sheet(layout, index, panels, &mut lengths);
             let on_sheet: Vec<FlatPanelRef> = layout
                 .placements
                 .iter()
                 .filter(|p| p.sheet == index)
-                .map(|p| flat.get(p.part))
+                .map(|p| panels.get(p.part))
                 .collect();
             let area: f64 = on_sheet.iter().map(|p| p.area).sum();
             let entry = manifest::SheetEntry {
@@ -341,26 +422,12 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         lengths.engrave += sheet.lengths.engrave;
         sheet_entries.push(sheet.entry);
     }
-    let mut manifest = build_manifest(
-        job,
-        &mesh,
-        &topology,
-        &split,
-        mm_per_unit,
-        &output,
-        &flat,
-        &layout,
-        lengths,
-        labels_left_out,
-        sheet_entries,
-        nesting,
-        spacing_bound,
-    );
+    let mut manifest = build_manifest(job, prepared, output, flat, nested, lengths, sheet_entries);
     files.push((
         format!("{name}-assembled.obj"),
         assembled_obj(&output.panels).into_bytes(),
     ));
-    manifest.warnings = size_check.warnings;
+    manifest.warnings = warnings;
     manifest.files = files
         .iter()
         .map(|(n, _)| n.clone())
@@ -369,9 +436,52 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let json = serde_json::to_string_pretty(&manifest)
         .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
     files.push((MANIFEST.into(), (json + "\n").into_bytes()));
+    Ok(Exported { files, manifest })
+}
+
+/// Runs a job and writes its output folder (replaced whole by a swap, so on any error
+/// the folder is left as it was; see [`crate::export::folder`] for the cases written
+/// in place).
+pub fn run(job: &Job) -> Result<Outcome> {
+    run_observed(job, &mut |_| {})
+}
+
+/// [`run`], handing each warning about the build to `warn` as soon as it is known
+/// (before the long stages), so a user can stop a build that is not what they meant.
+pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
+    let mut clock = Stopwatch::new();
+    // Refused before the long stages: a folder given as the model, and an output
+    // folder that holds files unfold did not write.
+    crate::mesh::read::model_format(&job.model_path)?;
+    let folder = check_output_folder(&job.out, &job.model_path, job.force)?;
+    let loaded = load(job)?;
+    clock.lap("load");
+    let prepared = prepare(job, loaded)?;
+    for warning in &prepared.warnings {
+        warn(warning);
+    }
+    clock.lap("split");
+    let output = scheme(job, &prepared)?;
+    clock.lap("scheme");
+    let flat = flatten(job, &prepared, &output)?;
+    if let Some(warning) = &flat.warning {
+        warn(warning);
+    }
+    clock.lap("flatten");
+    let nested = nest(job, &flat)?;
+    clock.lap("nest");
+    let warnings: Vec<String> = prepared
+        .warnings
+        .iter()
+        .chain(&flat.warning)
+        .cloned()
+        .collect();
+    let Exported { files, manifest } = export(job, &prepared, &output, &flat, &nested, warnings)?;
+    let mut notes = prepared.notes.clone();
+    notes.extend(output.notes.iter().cloned());
+    notes.extend(nested.notes.iter().cloned());
     notes.extend(folder.write(&files, &job.model_path)?);
     clock.lap("export");
-
     Ok(Outcome {
         manifest,
         files: files.into_iter().map(|(n, _)| n).collect(),
@@ -381,22 +491,24 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     })
 }
 
-#[allow(clippy::too_many_arguments)]
 fn build_manifest(
     job: &Job,
-    mesh: &crate::mesh::Mesh,
-    topology: &crate::mesh::Topology,
-    split: &crate::mesh::split::SplitReport,
-    mm_per_unit: f64,
-    output: &crate::scheme::SchemeOutput,
-    flat: &FlatPanels,
-    layout: &Layout,
+    prepared: &Prepared,
+    output: &SchemeOutput,
+    flat: &Flat,
+    nested: &Nested,
     lengths: Lengths,
-    labels_left_out: LeftOut,
     sheets: Vec<manifest::SheetEntry>,
-    nesting: manifest::Nesting,
-    spacing_bound: usize,
 ) -> Manifest {
+    let SchemeMesh {
+        mesh,
+        split,
+        mm_per_unit,
+        ..
+    } = &prepared.scheme_mesh;
+    let (topology, layout, labels_left_out) =
+        (&prepared.topology, &nested.layout, &flat.labels_left_out);
+    let flat = &flat.panels;
     let sheet = &layout.sheet;
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
@@ -445,7 +557,7 @@ fn build_manifest(
             name: job.scheme.name().to_string(),
             params: {
                 let mut params = job.scheme.params();
-                params.push("mm_per_model_unit", mm_per_unit);
+                params.push("mm_per_model_unit", *mm_per_unit);
                 params
             },
         },
@@ -462,14 +574,14 @@ fn build_manifest(
             panels: flat.len(),
             sheets: layout.sheets,
             sheets_lower_bound: lower_bound,
-            sheets_spacing_bound: spacing_bound,
+            sheets_spacing_bound: nested.spacing_bound,
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
             labels_left_out: labels_left_out.total(),
             panel_ids_left_out: labels_left_out.panel,
             partner_ids_left_out: labels_left_out.partner,
         },
-        nesting,
+        nesting: nested.nesting.clone(),
         panel_area: round4(panel_area),
         utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
         lengths: manifest::Lengths {

@@ -14,7 +14,7 @@ use common::build::{
 };
 use unfold::config::{Job, NonPlanar};
 use unfold::mesh::geometry::planarity_error;
-use unfold::run::{scheme_mesh, SchemeMesh};
+use unfold::run::SchemeMesh;
 
 fn job(model: &Path, nonplanar: NonPlanar, out: &Path) -> Job {
     let mut options = options("half-edge", "4ft", 0, out);
@@ -23,8 +23,10 @@ fn job(model: &Path, nonplanar: NonPlanar, out: &Path) -> Job {
 }
 
 fn mesh_for(job: &Job) -> SchemeMesh {
-    let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
-    scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh")
+    let loaded = unfold::run::load(job).expect("model loads");
+    unfold::run::prepare(job, loaded)
+        .expect("scheme mesh")
+        .scheme_mesh
 }
 
 /// Largest planarity error of the faces with four or more corners.

@@ -556,13 +556,13 @@ pub struct Pipeline {
     pub flat: Vec<FlatPanel>,
 }
 
-/// The pipeline of `src/run.rs` up to the flat panels: read, prepare, scale, split,
-/// scheme, flatten.
+/// The pipeline's stages (`unfold::run`) up to the scheme, then each panel flattened
+/// on its own (the tests follow single panels back to 3D).
 pub fn pipeline(job: &Job) -> Pipeline {
-    let (raw, prepared) = unfold::load_model(&job.model_path, &job.model).expect("model loads");
-    let unfold::run::SchemeMesh { mesh, split, .. } =
-        unfold::run::scheme_mesh(job, &raw, prepared.mesh).expect("scheme mesh");
-    let output = job.scheme.build(&mesh).expect("scheme");
+    let loaded = unfold::run::load(job).expect("model loads");
+    let prepared = unfold::run::prepare(job, loaded).expect("scheme mesh");
+    let output = unfold::run::scheme(job, &prepared).expect("scheme");
+    let unfold::run::SchemeMesh { mesh, split, .. } = prepared.scheme_mesh;
     let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
     let flat = panels
         .iter()

@@ -1,0 +1,129 @@
+//! The first stage of every job and of `inspect`: read a model and prepare it
+//! (repairs, `--min-component`, simplification to a panel budget).
+
+use std::path::Path;
+
+use crate::config::ModelSettings;
+use crate::error::{self, InputError, Result};
+use crate::mesh::{self, components::SmallComponents, Note, PrepareOptions, PreparedModel};
+
+/// What to do when a simplification budget was refused: the smallest budget found
+/// that works, or building without simplification.
+fn refused_budget_fix(
+    mesh: &mesh::Mesh,
+    budget: mesh::simplify::Budget,
+    mode: mesh::simplify::SimplifyMode,
+) -> String {
+    use mesh::simplify::Budget;
+    match mesh::simplify::smallest_working_budget(mesh, budget, mode) {
+        Some(Budget::Edges(n)) => {
+            format!("the smallest budget found that keeps it is --target-edges {n}")
+        }
+        Some(Budget::Faces(n)) => {
+            format!("the smallest budget found that keeps it is --target-faces {n}")
+        }
+        None => format!(
+            "no budget below the model's own {} edges keeps it; build it without --target-edges",
+            mesh.edge_count()
+        ),
+    }
+}
+
+/// Reads and prepares a model: the first two stages of every job. Simplification (with
+/// `--target-edges` / `--target-faces`) is part of preparation.
+pub fn load_model(
+    path: &Path,
+    settings: &ModelSettings,
+) -> Result<(mesh::RawModel, PreparedModel)> {
+    let raw = mesh::read_model(path)?;
+    let mut prepared = mesh::prepare(
+        &raw,
+        &PrepareOptions {
+            weld: settings.weld,
+        },
+    )?;
+    if settings.min_component > 1 {
+        drop_small_components(path, settings.min_component, &mut prepared)?;
+    }
+    if let Some(budget) = settings.budget {
+        let (simplified, report) =
+            mesh::simplify::simplify(&prepared.mesh, budget, settings.simplify_mode).map_err(
+                |e| {
+                    let fix = refused_budget_fix(&prepared.mesh, budget, settings.simplify_mode);
+                    InputError::new(path, error::Location::File, e.to_string(), fix)
+                },
+            )?;
+        let mode = match report.fallback {
+            None => format!("{} mode", settings.simplify_mode),
+            Some(used) => format!(
+                "{} mode did not keep the topology, so {used} was used",
+                settings.simplify_mode
+            ),
+        };
+        let message = if report.before == report.after {
+            format!(
+                "{} faces and {} edges are already within the budget; not simplified",
+                report.before.0, report.before.1
+            )
+        } else {
+            format!(
+                "simplified from {} faces and {} edges to {} faces and {} edges ({}; longest edge {:.1} times the median, 95 % within {:.2}){}; deviation from the original surface {:.3e} model units at most, {:.3e} on average (measured at every original vertex and triangle centre)",
+                report.before.0, report.before.1, report.after.0, report.after.1, mode,
+                report.edge_spread, report.edge_spread_95,
+                if report.relaxed_moves > 0 {
+                    format!("; vertices relaxed toward even edges in {} moves, without increasing the largest or mean deviation", report.relaxed_moves)
+                } else {
+                    String::new()
+                },
+                report.deviation, report.mean_deviation
+            )
+        };
+        prepared.notes.push(Note {
+            kind: "simplified",
+            message,
+        });
+        prepared.mesh = simplified;
+    }
+    Ok((raw, prepared))
+}
+
+/// `--min-component`: removes the components of fewer than `min_faces` faces, with a
+/// note; refuses a model where nothing would be left.
+fn drop_small_components(
+    path: &Path,
+    min_faces: usize,
+    prepared: &mut PreparedModel,
+) -> Result<()> {
+    let refuse = |problem: String| {
+        InputError::new(
+            path,
+            error::Location::File,
+            problem,
+            "lower --min-component",
+        )
+    };
+    match mesh::components::drop_small_components(&prepared.mesh, min_faces)
+        .map_err(|e| refuse(e.to_string()))?
+    {
+        SmallComponents::NoneSmall => Ok(()),
+        SmallComponents::AllSmall { largest } => Err(refuse(format!(
+            "every component has fewer than --min-component {min_faces} faces (the largest has {largest})"
+        ))
+        .into()),
+        SmallComponents::Dropped(kept, report) => {
+            let faces: usize = report.sizes.iter().sum();
+            let sizes: Vec<String> = report.sizes.iter().map(|n| n.to_string()).collect();
+            prepared.notes.push(Note {
+                kind: "small-components",
+                message: format!(
+                    "removed {} components with fewer than {min_faces} faces ({faces} faces; sizes {}); {} components kept",
+                    report.sizes.len(),
+                    sizes.join(", "),
+                    report.kept
+                ),
+            });
+            prepared.mesh = *kept;
+            Ok(())
+        }
+    }
+}
