@@ -92,10 +92,17 @@ pub fn main(registry: &Registry, args: impl IntoIterator<Item = OsString>) -> Ex
     match run(cli, registry) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("unfold: error: {e}");
+            // The whole chain of causes, each once: a message that already quotes
+            // its cause (an I/O error's reason) does not repeat it.
+            let mut shown = e.to_string();
+            eprintln!("unfold: error: {shown}");
             let mut source = std::error::Error::source(&e);
             while let Some(cause) = source {
-                eprintln!("  caused by: {cause}");
+                let text = cause.to_string();
+                if !shown.contains(&text) {
+                    eprintln!("  caused by: {text}");
+                    shown = text;
+                }
                 source = cause.source();
             }
             ExitCode::from(e.exit_code() as u8)
@@ -148,7 +155,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
             let report = crate::inspect(&model, &settings, nonplanar)?;
             let text = if json {
                 serde_json::to_string_pretty(&report)
-                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?
+                    .map_err(|e| Error::internal("writing the JSON summary", e))?
                     + "\n"
             } else {
                 report.to_text()
@@ -177,7 +184,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
             }
             if job.json {
                 let mut summary = serde_json::to_value(&outcome.manifest)
-                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?;
+                    .map_err(|e| Error::internal("writing the JSON summary", e))?;
                 if let Some(map) = summary.as_object_mut() {
                     map.remove("panels");
                     let times: serde_json::Map<String, serde_json::Value> = outcome
@@ -188,7 +195,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
                     map.insert("times".into(), times.into());
                 }
                 let text = serde_json::to_string_pretty(&summary)
-                    .map_err(|e| Error::Runtime(format!("cannot write JSON: {e}")))?;
+                    .map_err(|e| Error::internal("writing the JSON summary", e))?;
                 let _ = writeln!(std::io::stdout().lock(), "{text}");
             }
             Ok(())

@@ -63,7 +63,9 @@ impl fmt::Display for InputError {
 
 impl std::error::Error for InputError {}
 
-/// Every failure the library reports. The variant decides the exit code.
+/// Every failure the library reports. The variant decides the exit code
+/// ([`Error::exit_code`]); causes stay attached as sources, and `unfold` prints the
+/// whole chain.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Options or configuration the tool cannot use (exit code 2).
@@ -72,17 +74,48 @@ pub enum Error {
     /// An input model that cannot be used (exit code 3).
     #[error(transparent)]
     Input(#[from] InputError),
-    /// Anything that fails while running: output folder not writable, a panel larger
-    /// than the sheet, an internal error (exit code 1).
+    /// The model cannot be built as asked: a panel larger than the sheet, one that
+    /// overlaps itself (exit code 1).
     #[error("{0}")]
-    Runtime(String),
+    Build(String),
+    /// A file or folder that cannot be read or written (exit code 1).
+    #[error("cannot {action} {}: {source} (choose a writable --out folder)", path.display())]
+    Io {
+        /// What was being done ("create", "rename").
+        action: String,
+        /// On what.
+        path: PathBuf,
+        /// The system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A failure that is a bug of unfold, not a mistake of the user (exit code 1).
+    #[error("internal error while {doing}; this is a bug in unfold: please report it with the model file and the command line")]
+    Internal {
+        /// The step that failed ("unrolling the panels").
+        doing: String,
+        /// What failed inside it.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
 }
 
 impl Error {
+    /// An internal error of `doing`, caused by `source`.
+    pub fn internal(
+        doing: &str,
+        source: impl Into<Box<dyn std::error::Error + Send + Sync>>,
+    ) -> Error {
+        Error::Internal {
+            doing: doing.to_string(),
+            source: source.into(),
+        }
+    }
+
     /// The process exit code for this error: 1 runtime, 2 usage, 3 bad input model.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Runtime(_) => 1,
+            Error::Build(_) | Error::Io { .. } | Error::Internal { .. } => 1,
             Error::Usage(_) => 2,
             Error::Input(_) => 3,
         }
@@ -91,3 +124,38 @@ impl Error {
 
 /// The library's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn internal_errors_say_they_are_bugs_and_keep_their_cause() {
+        let cause = std::io::Error::other("facet 3 has no area");
+        let e = Error::internal("unrolling the panels", cause);
+        let text = e.to_string();
+        assert!(
+            text.contains("internal error while unrolling the panels"),
+            "{text}"
+        );
+        assert!(text.contains("bug in unfold"), "{text}");
+        assert_eq!(e.exit_code(), 1);
+        let source = std::error::Error::source(&e).expect("the cause is kept");
+        assert_eq!(source.to_string(), "facet 3 has no area");
+    }
+
+    #[test]
+    fn each_kind_has_its_exit_code() {
+        let io = Error::Io {
+            action: "create".into(),
+            path: PathBuf::from("/out"),
+            source: std::io::Error::from(std::io::ErrorKind::PermissionDenied),
+        };
+        assert!(io.to_string().starts_with("cannot create /out: "), "{io}");
+        assert_eq!(io.exit_code(), 1);
+        assert_eq!(Error::Build("panel E1 …".into()).exit_code(), 1);
+        assert_eq!(Error::Usage("--size".into()).exit_code(), 2);
+        let input = InputError::new(Path::new("m.obj"), Location::Line(3), "bad", "fix");
+        assert_eq!(Error::from(input).exit_code(), 3);
+    }
+}

@@ -128,7 +128,7 @@ pub fn scheme_mesh(
     }
     if split.count() > 0 {
         mesh = split_faces(&mesh, &split)
-            .map_err(|e| Error::Runtime(format!("splitting faces failed: {e}")))?;
+            .map_err(|e| Error::internal("splitting faces into triangles", e))?;
     }
     Ok(SchemeMesh {
         mesh,
@@ -150,7 +150,7 @@ pub fn planarize_faces(
         ..PlanarizeOptions::default()
     };
     planarize(mesh, &options).map_err(|e| {
-        Error::Runtime(format!(
+        Error::Build(format!(
             "{}: {e}; use --nonplanar triangulate",
             model_path.display()
         ))
@@ -261,7 +261,7 @@ pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
         if e.is_usage() {
             Error::Usage(message)
         } else {
-            Error::Runtime(message)
+            Error::Build(message)
         }
     })?;
     crate::memory::release_freed();
@@ -273,7 +273,7 @@ pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
 pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<Flat> {
     let mesh = &prepared.scheme_mesh.mesh;
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
-        .map_err(|e| Error::Runtime(format!("unrolling failed: {e}")))?;
+        .map_err(|e| Error::internal("unrolling the panels", e))?;
     let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out)?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
@@ -292,7 +292,7 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
         } else {
             "try a smaller --tab-height or --flap-scale".to_string()
         };
-        return Err(Error::Runtime(format!(
+        return Err(Error::Build(format!(
             "panel {} overlaps itself when unrolled; {advice}",
             bad.id()
         )));
@@ -315,7 +315,7 @@ pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
     };
     let outlines: Vec<Vec<DVec2>> = flat.iter().map(|p| p.outer()).collect();
     let too_large = |e: crate::nest::TooLarge| {
-        Error::Runtime(format!(
+        Error::Build(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
             flat.get(e.part).id(), e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))
@@ -434,7 +434,7 @@ pub fn export(
         .chain([MANIFEST.to_string()])
         .collect();
     let json = serde_json::to_string_pretty(&manifest)
-        .map_err(|e| Error::Runtime(format!("cannot write the manifest: {e}")))?;
+        .map_err(|e| Error::internal("writing the manifest", e))?;
     files.push((MANIFEST.into(), (json + "\n").into_bytes()));
     Ok(Exported { files, manifest })
 }

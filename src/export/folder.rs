@@ -285,10 +285,14 @@ impl OutputFolder {
                 Err(e) => return Err(fail("create", &path, e)),
             }
         }
-        Err(Error::Runtime(format!(
-            "cannot create a staging folder in {}: a thousand names are taken",
-            parent.display()
-        )))
+        Err(Error::Io {
+            action: "create a staging folder in".to_string(),
+            path: parent.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::AlreadyExists,
+                "a thousand names are taken",
+            ),
+        })
     }
 
     /// Replaces the folder whole: the old one (empty or only an earlier run's files)
@@ -446,10 +450,11 @@ fn remove_listed<'a>(dir: &Path, names: impl Iterator<Item = &'a str>) {
 }
 
 fn fail(what: &str, path: &Path, e: std::io::Error) -> Error {
-    Error::Runtime(format!(
-        "cannot {what} {}: {e} (choose a writable --out folder)",
-        path.display()
-    ))
+    Error::Io {
+        action: what.to_string(),
+        path: path.to_path_buf(),
+        source: e,
+    }
 }
 
 /// The files an earlier run's manifest says it wrote, or `None` when the bytes are not
