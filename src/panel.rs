@@ -8,7 +8,8 @@
 use glam::{DVec2, DVec3};
 use serde::Serialize;
 
-use crate::labels::LeftOut;
+use crate::font::text_width;
+use crate::mesh::geometry::vector_area;
 
 mod arena;
 
@@ -351,7 +352,7 @@ impl Panel {
         holes: Vec<Hole>,
         mut labels: Vec<Label>,
     ) -> Self {
-        let labels_dropped = crate::labels::drop_unfittable(&vertices, facets.view(), &mut labels);
+        let labels_dropped = drop_unfittable(&vertices, facets.view(), &mut labels);
         Panel {
             source,
             vertices,
@@ -1004,6 +1005,90 @@ impl FromIterator<FlatPanel> for FlatPanels {
         let mut all: FlatPanels = collect_arena(panels);
         all.shrink_to_fit();
         all
+    }
+}
+
+/// Smallest cap height worth engraving (mm).
+pub const MIN_HEIGHT: f64 = 1.5;
+
+/// Takes out of `labels` (of a 3D panel with these vertices and facets) those that
+/// cannot fit at any height fitting would try: the wanted height is below
+/// [`MIN_HEIGHT`], or the text box at [`MIN_HEIGHT`] has more area than the label's
+/// facet (than the largest facet for a panel id, which may move to another). A box
+/// inside a facet has less area than it, and a facet's area in the plane is at most
+/// its 3D vector area, so these labels would be left out anyway: dropping them early
+/// changes no output. Returns how many of each kind were dropped.
+pub(crate) fn drop_unfittable(
+    vertices: &[DVec3],
+    facets: LoopsRef,
+    labels: &mut Vec<Label>,
+) -> LeftOut {
+    let mut dropped = LeftOut::default();
+    if labels.is_empty() {
+        return dropped;
+    }
+    let areas: Vec<f64> = facets
+        .iter()
+        .map(|f| vector_area(f.iter().map(|&i| vertices[i as usize])).length())
+        .collect();
+    let largest = areas.iter().copied().fold(0.0, f64::max);
+    labels.retain(|label| {
+        let room = match label.kind {
+            LabelKind::Panel => largest,
+            _ => areas.get(label.facet as usize).copied().unwrap_or(largest),
+        };
+        // 1 % of slack for the rounding between the 3D and the flat areas.
+        let fits = label.height >= MIN_HEIGHT
+            && box_area(text_width(label.text), MIN_HEIGHT) <= 1.01 * room;
+        if !fits {
+            dropped.count(label.kind);
+        }
+        fits
+    });
+    dropped
+}
+
+/// The area of a label's box at cap height `height` ([`label_box`] of width
+/// `text_width * height`): what the early drop and the height skip compare with a
+/// facet's area.
+pub(crate) fn box_area(text_width: f64, height: f64) -> f64 {
+    text_width * height * height
+}
+
+/// How many labels of each kind were left out.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LeftOut {
+    /// Panel ids.
+    pub panel: usize,
+    /// Partner ids at connections.
+    pub partner: usize,
+    /// Vertex and face marks.
+    pub mark: usize,
+}
+
+impl LeftOut {
+    /// All kinds together.
+    pub fn total(&self) -> usize {
+        self.panel + self.partner + self.mark
+    }
+
+    pub(crate) fn count(&mut self, kind: LabelKind) {
+        match kind {
+            LabelKind::Panel => self.panel += 1,
+            LabelKind::Partner => self.partner += 1,
+            LabelKind::Mark => self.mark += 1,
+        }
+    }
+}
+
+impl std::ops::Add for LeftOut {
+    type Output = LeftOut;
+    fn add(self, o: LeftOut) -> LeftOut {
+        LeftOut {
+            panel: self.panel + o.panel,
+            partner: self.partner + o.partner,
+            mark: self.mark + o.mark,
+        }
     }
 }
 
