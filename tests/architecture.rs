@@ -144,7 +144,9 @@ fn each_layer_imports_only_what_lies_below_it() {
     // Panels are data: label fitting and unrolling read them, not the other way.
     offences.extend(imports_of(
         "panel",
-        &["labels", "flatten", "scheme", "nest", "export", "config", "run"],
+        &[
+            "labels", "flatten", "scheme", "nest", "export", "config", "run",
+        ],
     ));
     offences.extend(imports_of(
         "nest",
@@ -154,6 +156,27 @@ fn each_layer_imports_only_what_lies_below_it() {
         "export",
         &["mesh", "scheme", "config", "sanity", "run", "cli"],
     ));
+    assert!(offences.is_empty(), "{}", offences.join("\n"));
+}
+
+#[test]
+fn the_mesh_and_the_nester_know_nothing_of_the_command_line() {
+    let mut offences = Vec::new();
+    for dir in ["mesh", "nest"] {
+        for file in rust_files(&src().join(dir)) {
+            let text = code(&file);
+            for (i, line) in text.lines().enumerate() {
+                if line.contains("clap::") || line.contains("use clap") {
+                    offences.push(format!(
+                        "{}:{}: {}",
+                        file.strip_prefix(src()).unwrap().display(),
+                        i + 1,
+                        line.trim()
+                    ));
+                }
+            }
+        }
+    }
     assert!(offences.is_empty(), "{}", offences.join("\n"));
 }
 

@@ -89,6 +89,39 @@ pub fn parse_sheet(text: &str) -> std::result::Result<SheetSize, String> {
     })
 }
 
+/// `--simplify-mode`'s values (the mesh layer knows nothing of the command line).
+fn simplify_modes(
+) -> impl clap::builder::TypedValueParser<Value = crate::mesh::simplify::SimplifyMode> {
+    use crate::mesh::simplify::SimplifyMode;
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new([
+        PossibleValue::new("regular").help(
+            "Even triangle sizes and shapes, at some cost in closeness to the original surface: every edge becomes a panel, so panels come out of one size, assemble alike and lose less to the spacing",
+        ),
+        PossibleValue::new("accurate").help(
+            "The closest surface for the budget: flat regions keep few, large triangles and curved ones many small ones (panels from slivers to half a sheet long)",
+        ),
+    ])
+    .map(|name| match name.as_str() {
+        "accurate" => SimplifyMode::Accurate,
+        _ => SimplifyMode::Regular,
+    })
+}
+
+/// `--nester`'s values (the nest layer knows nothing of the command line).
+fn nesters() -> impl clap::builder::TypedValueParser<Value = NesterName> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new([
+        PossibleValue::new("true-shape")
+            .help("True shapes: sampled bottom-left placement, then emptying the emptiest sheet"),
+        PossibleValue::new("shelf").help("Bounding boxes in rows"),
+    ])
+    .map(|name| match name.as_str() {
+        "shelf" => NesterName::Shelf,
+        _ => NesterName::TrueShape,
+    })
+}
+
 /// Options that describe the model and its physical size (shared by `inspect` and the
 /// main command). Every field is optional so that the command line and the TOML file
 /// can be merged; [`ModelOptions::resolve`] fills in the defaults.
@@ -133,7 +166,7 @@ pub struct ModelOptions {
     /// panels of one size) or accurate (the closest surface: few
     /// large triangles where the model is flat, many small ones where it curves).
     /// [default: regular]
-    #[arg(long, value_name = "MODE")]
+    #[arg(long, value_name = "MODE", value_parser = simplify_modes())]
     pub simplify_mode: Option<crate::mesh::simplify::SimplifyMode>,
 
     /// Remove connected components with fewer than N faces (stray fragments of a scan,
@@ -372,7 +405,7 @@ pub struct BuildOptions {
     /// Layout of panels on sheets: true-shape (outlines, tabs and flaps included;
     /// small parts fill the gaps of large ones) or shelf (bounding boxes in rows, the
     /// baseline other unfolders use). [default: true-shape]
-    #[arg(long, value_name = "NESTER")]
+    #[arg(long, value_name = "NESTER", value_parser = nesters())]
     pub nester: Option<NesterName>,
 
     /// Search effort of the true-shape nester, 1 to 100: samples per placement and

@@ -23,7 +23,7 @@ pub enum Budget {
 }
 
 /// What the simplifier favours when it chooses which edges to collapse.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SimplifyMode {
     /// Even triangle sizes and shapes, at some cost in closeness to the original

@@ -113,7 +113,7 @@ impl Layout {
 }
 
 /// Nesters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NesterName {
     /// True shapes: sampled bottom-left placement, then emptying the emptiest sheet.
