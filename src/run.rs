@@ -513,28 +513,9 @@ fn build_manifest(
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
     let lower_bound = (panel_area / usable).ceil() as usize;
-    let panels = flat
-        .iter()
-        .zip(&layout.placements)
-        .map(|(p, placement)| manifest::PanelEntry {
-            id: p.id().to_string(),
-            sheet: placement.sheet + 1,
-            area: round4(p.area),
-            source: match p.source {
-                Source::Face(f) => manifest::PanelSource::Face {
-                    face: f,
-                    input_face: Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX),
-                },
-                Source::Edge(e) => manifest::PanelSource::Edge { edge: e },
-                Source::Cycle { cycle, segment } => manifest::PanelSource::Cycle { cycle, segment },
-            },
-            x: round4(placement.translation.x),
-            y: round4(placement.translation.y),
-            rotation_deg: round4(placement.rotation.to_degrees()),
-            mirrored: placement.mirrored,
-            developability_error: manifest::round_nm(p.developability_error),
-        })
-        .collect();
+    // Faces made by splitting or simplification have no face in the input file.
+    let input_face = |f: u32| Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX);
+    let panels = manifest::panel_entries(flat, layout, input_face);
     Manifest {
         tool: manifest::Tool {
             name: "unfold",
@@ -602,99 +583,16 @@ fn build_manifest(
     }
 }
 
-/// A laser path length for the report: millimetres below a metre, metres above.
-fn path_length(mm: f64) -> String {
-    if mm < 1000.0 {
-        format!("{mm:.0} mm")
-    } else {
-        format!("{:.1} m", mm / 1000.0)
-    }
-}
-
-/// The short report printed on stderr.
+/// The short report printed on stderr (written by [`crate::export::report`]).
 pub fn report_text(outcome: &Outcome, out: &Path) -> String {
-    use std::fmt::Write;
-    let m = &outcome.manifest;
-    let c = &m.counts;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "{}: {} scheme, {} panels, {} connections, {} fastener holes",
-        m.input.path, m.scheme.name, c.panels, c.connections, c.holes
-    );
-    let _ = writeln!(
-        s,
-        "sheets: {} of {} ({:.1} x {:.1} mm), {:.1} % of their area used; at least {} needed for this panel area at this spacing",
-        c.sheets,
-        m.sheet.name,
-        m.sheet.width,
-        m.sheet.height,
-        100.0 * m.utilization,
-        c.sheets_spacing_bound
-    );
-    for line in &outcome.scheme_report {
-        let _ = writeln!(s, "{line}");
-    }
-    let fills: Vec<String> = m
-        .sheets
-        .iter()
-        .map(|e| format!("{:.0}%", 100.0 * e.fill))
-        .collect();
-    let _ = writeln!(
-        s,
-        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {} sheets",
-        m.nesting.nester,
-        m.nesting.effort,
-        m.nesting.seed,
-        fills.join(" "),
-        m.nesting.shelf_sheets
-    );
-    let _ = writeln!(
-        s,
-        "laser paths: cut {}, score {}, engrave {}",
-        path_length(m.lengths.cut),
-        path_length(m.lengths.score),
-        path_length(m.lengths.engrave)
-    );
-    // Exact panels carry only float noise, rounded away in the manifest.
-    let error = m.max_developability_error;
-    if error == 0.0 {
-        let _ = writeln!(s, "flat panels: every panel unrolls exactly");
-    } else if error < 1e-3 {
-        let _ = writeln!(
-            s,
-            "flat panels: unrolling changes a facet edge by less than 0.001 mm"
-        );
-    } else {
-        let _ = writeln!(
-            s,
-            "flat panels: unrolling changes a facet edge by {error:.3} mm at most"
-        );
-    }
-    if c.labels_left_out > 0 {
-        let marks = c.labels_left_out - c.panel_ids_left_out - c.partner_ids_left_out;
-        let _ = writeln!(
-            s,
-            "labels left out (no room for a 1.5 mm cap height): {} panel ids, {} partner ids, {} vertex and face marks",
-            c.panel_ids_left_out, c.partner_ids_left_out, marks
-        );
-    }
-    for note in &outcome.notes {
-        let _ = writeln!(s, "note: {note}");
-    }
-    let times: Vec<String> = outcome
-        .times
-        .iter()
-        .map(|(stage, t)| format!("{stage} {:.0} ms", t.as_secs_f64() * 1e3))
-        .collect();
-    let _ = writeln!(s, "time: {}", times.join(", "));
-    let dxf = outcome.files.iter().any(|f| f.ends_with(".dxf"));
-    let _ = writeln!(
-        s,
-        "wrote {} files to {}{}",
-        outcome.files.len(),
-        out.display(),
-        if dxf { " (DXF in millimetres)" } else { "" }
-    );
-    s
+    crate::export::report::text(
+        &outcome.manifest,
+        &crate::export::report::Extras {
+            notes: &outcome.notes,
+            scheme_report: &outcome.scheme_report,
+            times: &outcome.times,
+            files: &outcome.files,
+        },
+        out,
+    )
 }

@@ -4,6 +4,8 @@
 
 use serde::Serialize;
 
+use crate::nest::Layout;
+use crate::panel::{FlatPanels, Source};
 use crate::record::Params;
 
 pub use crate::record::round4;
@@ -239,4 +241,34 @@ pub struct Manifest {
     pub files: Vec<String>,
     /// Every panel.
     pub panels: Vec<PanelEntry>,
+}
+
+/// Every panel's entry: id, sheet, area, source (with its face in the input file, from
+/// `input_face`), placement and developability error, in panel order.
+pub fn panel_entries(
+    flat: &FlatPanels,
+    layout: &Layout,
+    input_face: impl Fn(u32) -> Option<u32>,
+) -> Vec<PanelEntry> {
+    flat.iter()
+        .zip(&layout.placements)
+        .map(|(p, placement)| PanelEntry {
+            id: p.id().to_string(),
+            sheet: placement.sheet + 1,
+            area: round4(p.area),
+            source: match p.source {
+                Source::Face(f) => PanelSource::Face {
+                    face: f,
+                    input_face: input_face(f),
+                },
+                Source::Edge(e) => PanelSource::Edge { edge: e },
+                Source::Cycle { cycle, segment } => PanelSource::Cycle { cycle, segment },
+            },
+            x: round4(placement.translation.x),
+            y: round4(placement.translation.y),
+            rotation_deg: round4(placement.rotation.to_degrees()),
+            mirrored: placement.mirrored,
+            developability_error: round_nm(p.developability_error),
+        })
+        .collect()
 }

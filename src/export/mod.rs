@@ -7,6 +7,7 @@ pub mod dxf;
 pub mod folder;
 pub mod manifest;
 pub mod obj;
+pub mod report;
 pub mod svg;
 
 use glam::DVec2;

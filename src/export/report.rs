@@ -1,0 +1,115 @@
+//! The report printed on stderr after a run: the manifest's facts in plain words, the
+//! notes of every stage and the time of each.
+
+use std::path::Path;
+use std::time::Duration;
+
+use super::manifest::Manifest;
+
+/// What the report says beyond the manifest.
+pub struct Extras<'a> {
+    /// Observations of the stages (repairs, shortened tabs, split faces…).
+    pub notes: &'a [String],
+    /// The scheme's own lines (the woven cycles).
+    pub scheme_report: &'a [String],
+    /// Wall time per stage.
+    pub times: &'a [(&'static str, Duration)],
+    /// The files written.
+    pub files: &'a [String],
+}
+
+/// A laser path length for the report: millimetres below a metre, metres above.
+fn path_length(mm: f64) -> String {
+    if mm < 1000.0 {
+        format!("{mm:.0} mm")
+    } else {
+        format!("{:.1} m", mm / 1000.0)
+    }
+}
+
+/// The short report of a run: its manifest in plain words, then `extras`.
+pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
+    use std::fmt::Write;
+    let c = &m.counts;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: {} scheme, {} panels, {} connections, {} fastener holes",
+        m.input.path, m.scheme.name, c.panels, c.connections, c.holes
+    );
+    let _ = writeln!(
+        s,
+        "sheets: {} of {} ({:.1} x {:.1} mm), {:.1} % of their area used; at least {} needed for this panel area at this spacing",
+        c.sheets,
+        m.sheet.name,
+        m.sheet.width,
+        m.sheet.height,
+        100.0 * m.utilization,
+        c.sheets_spacing_bound
+    );
+    for line in extras.scheme_report {
+        let _ = writeln!(s, "{line}");
+    }
+    let fills: Vec<String> = m
+        .sheets
+        .iter()
+        .map(|e| format!("{:.0}%", 100.0 * e.fill))
+        .collect();
+    let _ = writeln!(
+        s,
+        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {} sheets",
+        m.nesting.nester,
+        m.nesting.effort,
+        m.nesting.seed,
+        fills.join(" "),
+        m.nesting.shelf_sheets
+    );
+    let _ = writeln!(
+        s,
+        "laser paths: cut {}, score {}, engrave {}",
+        path_length(m.lengths.cut),
+        path_length(m.lengths.score),
+        path_length(m.lengths.engrave)
+    );
+    // Exact panels carry only float noise, rounded away in the manifest.
+    let error = m.max_developability_error;
+    if error == 0.0 {
+        let _ = writeln!(s, "flat panels: every panel unrolls exactly");
+    } else if error < 1e-3 {
+        let _ = writeln!(
+            s,
+            "flat panels: unrolling changes a facet edge by less than 0.001 mm"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "flat panels: unrolling changes a facet edge by {error:.3} mm at most"
+        );
+    }
+    if c.labels_left_out > 0 {
+        let marks = c.labels_left_out - c.panel_ids_left_out - c.partner_ids_left_out;
+        let _ = writeln!(
+            s,
+            "labels left out (no room for a 1.5 mm cap height): {} panel ids, {} partner ids, {} vertex and face marks",
+            c.panel_ids_left_out, c.partner_ids_left_out, marks
+        );
+    }
+    for note in extras.notes {
+        let _ = writeln!(s, "note: {note}");
+    }
+    let times: Vec<String> = extras
+        .times
+        .iter()
+        .map(|(stage, t)| format!("{stage} {:.0} ms", t.as_secs_f64() * 1e3))
+        .collect();
+    let _ = writeln!(s, "time: {}", times.join(", "));
+    let dxf = extras.files.iter().any(|f| f.ends_with(".dxf"));
+    let _ = writeln!(
+        s,
+        "wrote {} files to {}{}",
+        extras.files.len(),
+        out.display(),
+        if dxf { " (DXF in millimetres)" } else { "" }
+    );
+    s
+}
