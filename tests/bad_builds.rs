@@ -853,13 +853,13 @@ fn refused_runs_do_not_create_the_output_folder() {
 }
 
 // ---------------------------------------------------------------------------------------
-// Huge lengths and models (panics, overflowing messages or silent acceptance before
-// lengths were bounded to 1 km and coordinates to ±1e15)
+// Huge lengths and models: lengths are bounded to 1 km and coordinates to ±1e15, so
+// none of these reaches the geometry
 // ---------------------------------------------------------------------------------------
 
 /// Huge lengths that should be refused as options (exit 2, naming the option).
 const HUGE_LENGTHS: &[OptionCase] = &[
-    // Once a panic (exit 101) in jagua-rs SPolygon::calculate_diameter, FloatIsNan.
+    // Would overflow the collision engine's f32 geometry (a NaN diameter).
     (&["--size", "1e300mm"], &["--size"]),
     (&["--scale", "1e300"], &["--scale"]),
     // A model built a nanometre across.
@@ -867,11 +867,11 @@ const HUGE_LENGTHS: &[OptionCase] = &[
     (&["--size", "1e-6mm"], &["--size", "smaller than 0.1 mm"]),
     (&["--sheet", "1e300x1e300in"], &["--sheet"]),
     (&["--spacing", "1e300mm"], &["--spacing"]),
-    // Once exit 1, "unrolling failed: panel F1: facet 1 has no area".
+    // Would make facets whose area overflows to no area.
     (&["--size", "1e30mm"], &["--size"]),
-    // Once accepted (exit 0); tabs were shortened to the neighbour face.
+    // A tab taller than any neighbour face is a typo, not a wish.
     (&["--tab-height", "1e300mm"], &["--tab-height"]),
-    // Once accepted; a note printed the diameter with 301 digits.
+    // A hole larger than the model; its note would print 301 digits.
     (
         &[
             "--size",
@@ -883,7 +883,7 @@ const HUGE_LENGTHS: &[OptionCase] = &[
         ],
         &["--hole-diameter"],
     ),
-    // Once accepted; the SVG got a 301-digit stroke-width.
+    // A 301-digit stroke-width in the SVG.
     (&["--stroke-width", "1e300mm"], &["--stroke-width"]),
 ];
 

@@ -72,25 +72,20 @@ pub struct NestOptions {
 const SAFETY: f64 = 0.02;
 
 /// Largest share of area the collision engine may add to a part's collision shape when
-/// it drops corners (the shape only grows, so the spacing holds). 0.1 % cuts the
-/// corners of the round offset joins and the Bézier rails: horse_quad winged-edge nests
-/// in 15.0 s instead of 20.3 s, spot half-edge in 5.7 s instead of 6.2 s, on the same
-/// sheet counts.
+/// it drops corners (the shape only grows, so the spacing holds): 0.1 % removes most
+/// corners of the round offset joins and the Bézier rails, which cost collision time,
+/// without costing a sheet.
 const SIMPLIFY: f32 = 0.001;
 
-/// Weight of the x coordinate in the bottom-left score (y counts 1). With the contact
-/// bonus, 0.5 packed tighter than 0.2 (below, with [`REFINED`]).
+/// Weight of the x coordinate in the bottom-left score (y counts 1): with the contact
+/// bonus, half weight packs tighter than smaller ones.
 const LEFT_WEIGHT: f32 = 0.5;
 
 /// Bonus in the placement score for an outline that touches placed parts or the
 /// sheet's edge, per part size (square root of its area) at full contact. Bottom-left
 /// alone leaves a part wherever its top is lowest, often in a corner that leaves a
-/// gap no other part fills; preferring poses that hug their neighbours packs tighter.
-/// Measured at weight 1 against 0 (default effort), when the construction was a
-/// first-fit decreasing by this search (before [`rows`]): the knight half-edge 14 → 13
-/// sheets; spot half-edge's last sheet 26 % → 9 % full and fertility's 29 % → 21 %,
-/// same counts; the bunny, suzanne, horse_quad (half-, quad-, winged-edge, woven) and
-/// spot quad-edge same counts. Weights 0.5 and 2 did no better.
+/// gap no other part fills; preferring poses that hug their neighbours packs tighter,
+/// and weight 1 packs best of the weights tried (0.5 to 2).
 const CONTACT_WEIGHT: f32 = 1.0;
 
 /// How far (mm) inside the sheet's bounds a clamped candidate stays.
@@ -101,16 +96,13 @@ const EDGE_GAP: f32 = 0.01;
 const CLOSE_AFTER_FAILURES: u32 = 40;
 
 /// Collision checks the squeeze may spend per unit of effort (an evaluation of a
-/// pose's overlap counts as several: see `separate`). At the default effort, about
-/// what the bunny at 2 mm spacing needs to take its last sheet away (13 → 12 sheets,
-/// 21.5 million); about 5 s on the development machine.
+/// pose's overlap counts as several: see `separate`): at the default effort, what a
+/// job of about a thousand parts needs to take a last sheet of a few parts away.
 const SQUEEZE_CHECKS: u64 = 5_000_000;
 
-/// Parts the emptiest sheet may hold, per unit of effort, for the squeeze to try it.
-/// Squeezing one part into a full sheet took 0.5–1.5 s of separation on spot
-/// quad-edge (1.4–3.5 million checks): the squeeze pays where the last sheet holds a
-/// few parts (the bunny at 2 mm spacing: 5), not where it holds hundreds of small
-/// ones (spot quad-edge: 278, a 5 % sheet).
+/// Parts the emptiest sheet may hold, per unit of effort, for the squeeze to try it:
+/// squeezing one part into a full sheet costs about a second of separation, so the
+/// squeeze pays where the last sheet holds a few parts, not hundreds.
 const SQUEEZE_PARTS: usize = 2;
 
 /// Separation rounds per squeezed part and sheet tried, per unit of effort.
@@ -155,12 +147,8 @@ struct Candidate {
     y: f32,
 }
 
-/// How many of the best samples get the local search. Measured (with the first-fit
-/// construction, before [`rows`]) with the contact bonus
-/// (seeds 0 and 1), 6 with a left weight of 0.5 against 3 with 0.2: spot half-edge 26
-/// → 25 sheets (nest 6.2 → 8.8 s), suzanne 17 → 16 at seed 0, the knight and the bunny
-/// the same counts with emptier last sheets (bunny 53 % → 37 %, 59 % → 34 %); 8 gave
-/// little more for 30 % more time, 4 lost suzanne's sheet.
+/// How many of the best samples get the local search: six packs tighter than fewer,
+/// and more cost about a third more time for little.
 const REFINED: usize = 6;
 
 /// Fewest samples one parallel task tests (fewer would cost more to hand out).
