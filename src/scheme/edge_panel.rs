@@ -8,11 +8,20 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::{face_band, fraction, PanelOptions};
+use super::{face_band, fraction, PanelDefaults, PanelOptions};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
 use crate::record::Params;
+
+/// The edge schemes' defaults for the shared options: bands halfway to the face
+/// centre leave room for the flaps, and two pins per corner keep a connection from
+/// turning.
+pub const EDGE_DEFAULTS: PanelDefaults = PanelDefaults {
+    face_scale: 0.5,
+    holes: 2,
+    holes_allowed: &[0, 1, 2, 4],
+};
 
 /// The options of the edge band, shared by the edge schemes, as given.
 #[derive(Clone, Debug, Default, clap::Args)]

@@ -17,6 +17,7 @@ use glam::DVec2;
 
 use super::edge_panel::{
     band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -62,11 +63,7 @@ impl Scheme for WingedEdge {
     }
 
     fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            face_scale: 0.5,
-            holes: 2,
-            holes_allowed: &[0, 1, 2, 4],
-        }
+        EDGE_DEFAULTS
     }
 
     fn needs_convex_faces(&self) -> bool {
