@@ -26,7 +26,7 @@ use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
-    check_output, check_sheets, count, distance_to_border, frames_of, golden_build, inside,
+    build, check_output, check_sheets, count, distance_to_border, frames_of, golden_build, inside,
     inspect_json, model, num, pipeline, read_simple_obj, resolve, shared_models, DxfCheck,
     Pipeline, Run,
 };
@@ -35,6 +35,7 @@ use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use unfold::panel::{FlatPanel, Panel, Source};
 use unfold::scheme::edge_panel::EdgeOptions;
+use unfold::scheme::quad_edge::MAX_FLAP_SCALE;
 
 // =======================================================================================
 // Helpers
@@ -473,9 +474,16 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                 ),
                 band_corner(mesh, face, mesh.position(mesh.dest(he)), o.panel.face_scale),
             );
-            let lerp = |p: DVec3| p + o.flap_scale * (c - p);
-            let (iv, iw) = (to2(lerp(bv)), to2(lerp(bw)));
+            // The flap is the band between its band edge and one inner line parallel to
+            // it: its depth (in units of the band edge's distance from the centre)
+            // is --flap-scale, or deeper, up to MAX_FLAP_SCALE, where a corner needs
+            // room for its holes.
+            let u = (to2(bw) - to2(bv)).normalize();
+            // Distance inward from the band edge (the centre is at `reach`).
+            let inward = |q2: DVec2| u.perp_dot(q2 - to2(bv)) * u.perp_dot(-to2(bv)).signum();
+            let reach = inward(DVec2::ZERO);
             let corners: Vec<DVec3> = panel.facets[facet].iter().map(|&i| at(i)).collect();
+            let mut inner_line: Option<f64> = None;
             for (k, &q) in corners.iter().enumerate() {
                 let off = (q - c).dot(nrm).abs();
                 assert!(
@@ -489,22 +497,29 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
                     "{what}: {} flap {facet} corner {k} leaves the face band",
                     fp.id()
                 );
-                let is_band_corner = band.iter().any(|&b| b.distance(q) <= tol);
-                // Signed distance from the inner line, positive toward the band edge.
-                let side = (iw - iv).normalize().perp_dot(q2 - iv);
-                let edge_side = (iw - iv).normalize().perp_dot(to2(bv) - iv);
+                let depth = inward(q2);
                 assert!(
-                    side * edge_side.signum() >= -tol,
-                    "{what}: {} flap {facet} corner {k} is beyond the inner line",
+                    depth >= -tol && depth <= MAX_FLAP_SCALE * reach + tol,
+                    "{what}: {} flap {facet} corner {k} is {depth} mm in from its band edge, beyond the deepest inner line",
                     fp.id()
                 );
-                if !is_band_corner {
+                let is_band_corner = band.iter().any(|&b| b.distance(q) <= tol);
+                // The other corners are where the inner line meets the band.
+                if !is_band_corner && depth > tol {
+                    let line = *inner_line.get_or_insert(depth);
                     assert!(
-                        side.abs() <= tol,
-                        "{what}: {} flap {facet} corner {k} is neither a band corner nor on the inner line ({side:e} mm off)",
+                        (depth - line).abs() <= tol,
+                        "{what}: {} flap {facet} corner {k} is neither a band corner nor on the flap's inner line ({depth} vs {line} mm)",
                         fp.id()
                     );
                 }
+            }
+            if let Some(line) = inner_line {
+                assert!(
+                    line >= o.flap_scale * reach - tol,
+                    "{what}: {} flap {facet} is shallower ({line} mm) than --flap-scale",
+                    fp.id()
+                );
             }
             // The flap starts on the band edge of its edge.
             for b in [bv, bw] {
@@ -605,9 +620,10 @@ fn check_holes(
                 hole.connection
             );
             let clear = distance_to_border(&facet, hole.center);
+            let margin = o.panel.hole_margin;
             assert!(
-                clear >= r + d - tol,
-                "{what}: {} hole of connection {} is {clear} mm from its flap's border: radius {r} + one diameter {d} wanted",
+                clear >= r + margin - tol,
+                "{what}: {} hole of connection {} is {clear} mm from its flap's border: radius {r} + the margin {margin} wanted",
                 fp.id(),
                 hole.connection
             );
@@ -726,9 +742,9 @@ fn check_holes(
             );
             worst_apart = worst_apart.max(nearest);
         }
-        // In the corner's face, inside the overlap of the two flaps meeting there (the
-        // face band, cut by the inner lines of the corner's two band edges), with one
-        // diameter of material to its border.
+        // In the corner's face, inside its band with the margin to the band's border
+        // (the flat check above holds each hole to its own flap's outline, so to the
+        // overlap of the two flaps).
         let cf = centre(mesh, f);
         let nf = normal(mesh, f);
         let ex = (mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h))).normalize();
@@ -738,28 +754,7 @@ fn check_holes(
             .face_positions(f)
             .map(|v| to2(band_corner(mesh, f, v, o.panel.face_scale)))
             .collect();
-        // Signed distance from the inner line of the band edge of half-edge `g`,
-        // positive on the band edge's side.
-        let inner = |g: HalfedgeId, q: DVec2| {
-            let (bv, bw) = (
-                to2(band_corner(
-                    mesh,
-                    f,
-                    mesh.position(mesh.origin(g)),
-                    o.panel.face_scale,
-                )),
-                to2(band_corner(
-                    mesh,
-                    f,
-                    mesh.position(mesh.dest(g)),
-                    o.panel.face_scale,
-                )),
-            );
-            let (iv, iw) = (bv * (1.0 - o.flap_scale), bw * (1.0 - o.flap_scale));
-            let u = (iw - iv).normalize();
-            let side = u.perp_dot(q - iv);
-            side * u.perp_dot(bv - iv).signum()
-        };
+        let margin = o.panel.hole_margin;
         for (_, q) in on_a.iter().chain(&on_b) {
             let off = (*q - cf).dot(nf).abs();
             assert!(
@@ -772,12 +767,10 @@ fn check_holes(
                 distance_to_border(&band, q2)
             } else {
                 -distance_to_border(&band, q2)
-            }
-            .min(inner(h, q2))
-            .min(inner(mesh.prev(h), q2));
+            };
             assert!(
-                clear >= r + d - tol,
-                "{what}: connection {c}: a hole is {clear} mm inside the overlap of the flaps at corner {} of face {}, radius {r} + one diameter {d} wanted",
+                clear >= r + margin - tol,
+                "{what}: connection {c}: a hole is {clear} mm inside the band at corner {} of face {}, radius {r} + the margin {margin} wanted",
                 mesh.origin(h).0,
                 f.0
             );
@@ -1166,6 +1159,39 @@ fn holes_everywhere(name: &str, size: &str, size_mm: f64, holes: u32, extra: &[&
     );
 }
 
+/// At the defaults, the platonic solids and the 6 × 4 torus at 1 ft get two holes at
+/// every connection (the flaps grow where a corner needs the room), partner holes
+/// meeting in 3D; the manifest counts them by connection.
+#[test]
+fn solids_at_one_foot_get_two_holes_at_every_connection() {
+    let tmp = TempDir::new().unwrap();
+    for name in [
+        "tetrahedron",
+        "hexahedron",
+        "octahedron",
+        "dodecahedron",
+        "icosahedron",
+        "torus-6x4",
+    ] {
+        holes_everywhere(name, "1ft", 304.8, 2, &[]);
+        let m = build(
+            "quad-edge",
+            &model(name),
+            "1ft",
+            &tmp.path().join(name),
+            &[],
+        );
+        let connections = count(&m, "counts.connections");
+        assert_eq!(
+            m["counts"]["connections_by_holes"],
+            serde_json::json!({ "2": connections }),
+            "{name}"
+        );
+        assert_eq!(count(&m, "counts.fasteners"), 2 * connections, "{name}");
+        assert_eq!(count(&m, "counts.holes"), 4 * connections, "{name}");
+    }
+}
+
 #[test]
 fn holes_of_a_connection_meet_in_3d() {
     // The scheme's note says which sizes have room: the platonic solids at 300 mm do;
@@ -1182,9 +1208,11 @@ fn holes_of_a_connection_meet_in_3d() {
 /// paired, and says how many connections got fewer.
 #[test]
 fn fewer_holes_where_the_overlap_is_small() {
+    // Sizes at which even the deepest flaps cannot hold every wanted hole (at 300 mm
+    // and 600 mm the grown flaps hold them all).
     for (name, size, size_mm, holes) in [
-        ("icosahedron", "300mm", 300.0, 4),
-        ("genus3", "600mm", 600.0, 2),
+        ("icosahedron", "100mm", 100.0, 4),
+        ("genus3", "300mm", 300.0, 2),
     ] {
         let path = model(name);
         let what = format!("{name} at {size} --holes {holes}");

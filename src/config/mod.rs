@@ -386,6 +386,13 @@ pub struct BuildOptions {
     #[arg(long, value_name = "LENGTH")]
     pub hole_diameter: Option<String>,
 
+    /// Material kept between a fastener hole's rim and every cut edge of the panels it
+    /// goes through, and between two holes, with a unit; half a hole diameter lets a
+    /// fastener head of twice the hole's diameter bear on material all round.
+    /// [default: half the --hole-diameter]
+    #[arg(long, value_name = "LENGTH")]
+    pub hole_margin: Option<String>,
+
     /// Cap height of engraved labels, with a unit; shrunk to fit each panel, left out
     /// below 1.5 mm. [default: 4mm]
     #[arg(long, value_name = "LENGTH")]
@@ -584,6 +591,7 @@ impl BuildOptions {
             face_scale: self.face_scale.or(other.face_scale),
             holes: self.holes.or(other.holes),
             hole_diameter: self.hole_diameter.or(other.hole_diameter),
+            hole_margin: self.hole_margin.or(other.hole_margin),
             label_height: self.label_height.or(other.label_height),
             nonplanar: self.nonplanar.or(other.nonplanar),
             rotations: self.rotations.or(other.rotations),
@@ -744,10 +752,22 @@ impl BuildOptions {
                 time_limit,
             },
         };
+        let hole_diameter = length("hole-diameter", &self.hole_diameter, "0.125in")?;
+        let hole_margin = match &self.hole_margin {
+            Some(text) => {
+                let mm = parse_length(text).map_err(|e| usage("hole-margin", e))?;
+                if mm < 0.0 {
+                    return Err(usage("hole-margin", format!("'{text}' cannot be negative")));
+                }
+                mm
+            }
+            None => 0.5 * hole_diameter,
+        };
         let panel = PanelOptions {
             face_scale,
             holes,
-            hole_diameter: length("hole-diameter", &self.hole_diameter, "0.125in")?,
+            hole_diameter,
+            hole_margin,
             label_height: length("label-height", &self.label_height, "4mm")?,
             panel_limit: Some(PanelLimit {
                 width: sheet.width - 2.0 * margin,

@@ -122,6 +122,10 @@ pub struct Counts {
     pub holes: usize,
     /// Connections between panels.
     pub connections: usize,
+    /// Connections by the number of fastener holes each has ("0", "1", "2", "4").
+    pub connections_by_holes: std::collections::BTreeMap<String, usize>,
+    /// Fasteners needed: one per pair of holes (a hole through both panels).
+    pub fasteners: usize,
     /// Labels left out because no legible size fits (all kinds).
     pub labels_left_out: usize,
     /// Of those, panel ids.

@@ -37,6 +37,19 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         "{}: {} scheme, {} panels, {} connections, {} fastener holes",
         m.input.path, m.scheme.name, c.panels, c.connections, c.holes
     );
+    if c.holes > 0 {
+        let by: Vec<String> = c
+            .connections_by_holes
+            .iter()
+            .map(|(holes, n)| format!("{n} with {holes}"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "fasteners: {} (one per pair of holes); connections by holes: {}",
+            c.fasteners,
+            by.join(", ")
+        );
+    }
     let _ = writeln!(
         s,
         "sheets: {} of {} ({:.1} x {:.1} mm), {:.1} % of their area used; at least {} needed for this panel area at this spacing",

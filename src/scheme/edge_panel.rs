@@ -106,6 +106,8 @@ pub struct FaceFlaps {
     pub reduced: usize,
     /// Connections with no hole at all although holes were wanted.
     pub bare: usize,
+    /// Connections whose flaps grew deeper than `--flap-scale` to hold their holes.
+    pub grown: usize,
 }
 
 impl FaceFlaps {
@@ -124,6 +126,7 @@ impl FaceFlaps {
             holes: Vec::new(),
             reduced: 0,
             bare: 0,
+            grown: 0,
         }
     }
 
@@ -244,26 +247,29 @@ pub fn corner_half_edges(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
 
 /// Pin positions in an overlap: symmetric about `centre` along `along` (the overlap's
 /// long direction) at the closest spacing that leaves one diameter of material between
-/// pins, each with one diameter of material to the overlap's border (outlines and
-/// score lines). When the wanted count does not fit, fewer pins (4 → 2 → 1 → 0).
+/// pins (so heads twice the hole's size do not overlap), each with `margin` of
+/// material to the overlap's border (every side of an overlap is a cut edge of one of
+/// the two panels). When the wanted count does not fit, fewer pins (4 → 2 → 1 → 0).
 /// Returns the centres and whether fewer than wanted were placed.
 pub fn place_pins(
     overlap: &[DVec2],
     centre: DVec2,
     along: DVec2,
     wanted: u32,
-    diameter: f64,
+    panel: &PanelOptions,
 ) -> (Vec<DVec2>, bool) {
     if wanted == 0 || overlap.len() < 3 {
         return (Vec::new(), wanted > 0);
     }
+    let diameter = panel.hole_diameter;
     let r = 0.5 * diameter;
     let u = along.normalize_or_zero();
     let w = u.perp();
     let half = 0.5 * (2.0 * r + diameter);
     let fits = |pins: &[DVec2]| {
-        pins.iter()
-            .all(|&p| contains(overlap, p) && distance_to_border(overlap, p) >= r + diameter)
+        pins.iter().all(|&p| {
+            contains(overlap, p) && distance_to_border(overlap, p) >= r + panel.hole_margin
+        })
     };
     for count in [4, 2, 1].into_iter().filter(|&c| c <= wanted) {
         let pins: Vec<DVec2> = match count {
@@ -314,11 +320,21 @@ pub fn edge_scheme_notes(
 ) -> Vec<String> {
     let reduced: usize = faces.iter().map(|f| f.reduced).sum();
     let bare: usize = faces.iter().map(|f| f.bare).sum();
+    let grown: usize = faces.iter().map(|f| f.grown).sum();
+    let panel = &options.panel;
     let mut notes = Vec::new();
+    if grown > 0 {
+        notes.push(format!(
+            "{grown} of {connections} connections have deeper flaps than --flap-scale {} to hold their fastener holes",
+            options.flap_scale
+        ));
+    }
     if reduced > 0 {
         notes.push(format!(
-            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlap cannot hold more {} mm holes with one diameter of material around each; a larger --size, smaller --hole-diameter or larger --flap-scale helps",
-            options.panel.holes, options.panel.hole_diameter
+            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlaps cannot hold more {} mm holes with {} mm of material around each; a larger --size, a smaller --hole-diameter or --hole-margin, or fewer panels (--target-edges) helps",
+            panel.holes,
+            crate::units::fmt_num(panel.hole_diameter),
+            crate::units::fmt_num(panel.hole_margin)
         ));
     }
     let boundary = mesh.edges().filter(|&e| mesh.is_boundary_edge(e)).count();

@@ -470,7 +470,8 @@ fn place_holes(
         return (Vec::new(), false);
     }
     let r = 0.5 * options.panel.hole_diameter;
-    let clearance = 2.0 * r;
+    // The hole's radius and the margin of material to the tab's and the face's edges.
+    let clearance = r + options.panel.hole_margin;
     let v = 0.5 * (gap + top_height);
     // The tab's extent at height v (it is convex: two crossings).
     let mut xs = Vec::new();
@@ -496,7 +497,7 @@ fn place_holes(
             && distance_to_border(&band, c) >= clearance
     }) && centres
         .windows(2)
-        .all(|w| w[0].distance(w[1]) >= 2.0 * clearance);
+        .all(|w| w[0].distance(w[1]) >= 2.0 * r + options.panel.hole_diameter);
     if fits {
         (centres, false)
     } else {

@@ -88,6 +88,9 @@ pub struct PanelOptions {
     pub holes: u32,
     /// Hole diameter (mm).
     pub hole_diameter: f64,
+    /// Material kept between a hole's rim and any cut edge of the panels it goes
+    /// through, and between the rims of two holes of a connection (mm).
+    pub hole_margin: f64,
     /// Wanted label cap height (mm).
     pub label_height: f64,
     /// The largest panel the layout can take; schemes that can cut long panels
@@ -348,6 +351,7 @@ impl ConfiguredScheme {
         params.push("face_scale", panel.face_scale);
         params.push("holes", panel.holes);
         params.push("hole_diameter", round4(panel.hole_diameter));
+        params.push("hole_margin", round4(panel.hole_margin));
         params.push("label_height", round4(panel.label_height));
         params.extend(self.options.params());
         params

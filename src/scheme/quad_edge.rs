@@ -26,7 +26,7 @@ use super::edge_panel::{
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
-use crate::plane::clip_half_plane;
+use crate::plane::{clip_half_plane, contains, distance_to_border};
 use crate::record::Params;
 
 pub use super::edge_panel::panel_id;
@@ -89,56 +89,197 @@ pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
     edge_scheme(mesh, options, face_flaps)
 }
 
-/// Band, flaps and corner overlaps of one face, computed in its plane.
+/// The deepest a flap grows, in units of its band edge's distance from the face centre
+/// (1 reaches the centre): beyond one and a half, a triangle's flaps cover the third
+/// flap's corners, where its own holes go.
+pub const MAX_FLAP_SCALE: f64 = 1.5;
+
+/// Steps from `--flap-scale` to [`MAX_FLAP_SCALE`] tried when a corner's overlap is too
+/// small for its holes.
+const FLAP_STEPS: u32 = 16;
+
+/// A face corner's plan: how deep its two flaps go, its label point and its pins.
+#[derive(Clone)]
+struct Corner {
+    depth: f64,
+    centre: DVec2,
+    pins: Vec<DVec2>,
+}
+
+/// Band, flaps and corner overlaps of one face, computed in its plane. Each band edge's
+/// flap starts at `--flap-scale`; where a corner's overlap cannot hold its holes, the
+/// two flaps meeting there grow (to the smallest depth that holds the most holes that
+/// fit by [`MAX_FLAP_SCALE`]), so every connection gets its fasteners where the face has
+/// room for them.
 fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
-    let flap = options.flap_scale;
-    // Inner line of band edge k, directed like the edge, through the band corners moved
-    // toward the centre (the frame's origin). The flap is the band clipped to the strip
-    // between its edge and that line: the same as running its sides along the
-    // neighbouring band edges, and it never leaves the band when a neighbouring edge is
-    // nearly parallel (sliver triangles).
-    let inner_line = |k: usize| ((1.0 - flap) * b[k], (1.0 - flap) * b[(k + 1) % n]);
-    let flaps: Vec<Vec<DVec2>> = (0..n)
-        .map(|k| {
-            let (p, q) = inner_line(k);
-            // Left of q → p is between the edge and the inner line.
-            let clipped = clip_half_plane(&b, q, p);
-            // Start the loop at B_k, B_k+1 (both kept exactly by the clip).
-            let start = clipped.iter().position(|&x| x == b[k]).unwrap_or(0);
-            (0..clipped.len())
-                .map(|i| clipped[(start + i) % clipped.len()])
-                .collect()
-        })
-        .collect();
-
-    let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
-    for flap in &flaps {
-        parts.push_flap(flap.iter().skip(2).map(|&q| frame.to3(q)));
-    }
-    for k in 0..n {
+    let panel = &options.panel;
+    // Inner line of band edge k at depth `depth`, directed like the edge, through the
+    // band corners moved toward the centre (the frame's origin). The flap is the band
+    // clipped to the strip between its edge and that line: the same as running its
+    // sides along the neighbouring band edges, and it never leaves the band when a
+    // neighbouring edge is nearly parallel (sliver triangles).
+    let inner_line = |k: usize, depth: f64| {
+        let p = (1.0 - depth) * b[k];
+        (p, p + (b[(k + 1) % n] - b[k]))
+    };
+    let flap_at = |k: usize, depth: f64| -> Vec<DVec2> {
+        let (p, q) = inner_line(k, depth);
+        // Left of q → p is between the edge and the inner line.
+        let clipped = clip_half_plane(&b, q, p);
+        // Start the loop at B_k, B_k+1 (both kept exactly by the clip).
+        let start = clipped.iter().position(|&x| x == b[k]).unwrap_or(0);
+        (0..clipped.len())
+            .map(|i| clipped[(start + i) % clipped.len()])
+            .collect()
+    };
+    // The overlap at corner k with both flaps at `depth`: the previous edge's flap
+    // clipped by this edge's strip, and its pins.
+    let corner_pins = |k: usize, depth: f64, wanted: u32| {
         let prev = (k + n - 1) % n;
-        // The overlap at corner k: the previous edge's flap clipped by this edge's strip.
-        let (p, q) = inner_line(k);
-        let overlap = clip_half_plane(&flaps[prev], q, p);
+        let (p, q) = inner_line(k, depth);
+        let overlap = clip_half_plane(&flap_at(prev, depth), q, p);
         let centre = if overlap.is_empty() {
             b[k]
         } else {
             overlap.iter().copied().sum::<DVec2>() / overlap.len() as f64
         };
-        parts.set_corner_label(k, frame.to3(centre));
-        // Pins along the line from the corner through the overlap's centre.
-        let (pins, fewer) = place_pins(
-            &overlap,
-            centre,
-            centre - b[k],
-            options.panel.holes,
-            options.panel.hole_diameter,
+        // At --flap-scale pins sit about the overlap's centre, with the most material
+        // around them; in grown flaps, or where they do not fit there, they hug the
+        // corner along its bisector, as near as the margins let them (far from the
+        // face's other flaps, which grow too).
+        let (e1, e2) = (
+            (b[(k + 1) % n] - b[k]).normalize_or_zero(),
+            (b[prev] - b[k]).normalize_or_zero(),
         );
-        parts.reduced += fewer as usize;
-        parts.bare += (options.panel.holes > 0 && pins.is_empty()) as usize;
+        let u = (e1 + e2).normalize_or_zero();
+        let sin_half = e1.perp_dot(u).abs().max(1e-6);
+        let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
+        let hug = |pins: u32| {
+            // The inner of two pins along the bisector is `hole_diameter` nearer the
+            // corner than their centre (see `place_pins`).
+            let offset = if pins >= 2 { panel.hole_diameter } else { 0.0 };
+            b[k] + u * ((clear * 1.0001) / sin_half + offset)
+        };
+        let tries = if depth > options.flap_scale {
+            [hug(wanted.min(2)), hug(1), centre]
+        } else {
+            [centre, hug(wanted.min(2)), hug(1)]
+        };
+        // Two pins lie along the bisector, or, in an overlap long along one of its
+        // band edges (a thin face), about its centre along that edge.
+        let tries = tries
+            .into_iter()
+            .map(|c| (c, u))
+            .chain([(centre, e1), (centre, e2)]);
+        let best = tries
+            .map(|(c, along)| (c, place_pins(&overlap, c, along, wanted, panel).0))
+            .fold((centre, Vec::new()), |best, tried| {
+                // The first of the most wins ties.
+                if tried.1.len() > best.1.len() {
+                    tried
+                } else {
+                    best
+                }
+            });
+        (centre, best.1)
+    };
+    let depths: Vec<f64> = (0..FLAP_STEPS + 1)
+        .map(|i| {
+            let t = f64::from(i) / f64::from(FLAP_STEPS);
+            options.flap_scale + t * (MAX_FLAP_SCALE - options.flap_scale).max(0.0)
+        })
+        .collect();
+    // Per corner: the shallowest depth at which its two flaps hold `wanted` pins, with
+    // the pins (placed for that depth, they stay valid when the flaps grow deeper:
+    // only their inner lines move, away from the pins).
+    let plan = |k: usize, wanted: u32| -> Option<Corner> {
+        depths.iter().find_map(|&depth| {
+            let (centre, pins) = corner_pins(k, depth, wanted);
+            (pins.len() as u32 >= wanted).then_some(Corner {
+                depth,
+                centre,
+                pins,
+            })
+        })
+    };
+    let flap_depths = |corners: &[Corner]| -> Vec<f64> {
+        (0..n)
+            .map(|k| corners[k].depth.max(corners[(k + 1) % n].depth))
+            .collect()
+    };
+    // A pin goes through the two flaps of its corner only: it must stay clear of the
+    // face's other flaps, which grow too in small faces.
+    let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
+    let apart =
+        |pin: DVec2, flap: &[DVec2]| !contains(flap, pin) && distance_to_border(flap, pin) >= clear;
+    let conflicts = |corners: &[Corner]| -> bool {
+        let flaps: Vec<Vec<DVec2>> = flap_depths(corners)
+            .iter()
+            .enumerate()
+            .map(|(j, &d)| flap_at(j, d))
+            .collect();
+        corners.iter().enumerate().any(|(k, c)| {
+            let prev = (k + n - 1) % n;
+            c.pins.iter().any(|&pin| {
+                flaps
+                    .iter()
+                    .enumerate()
+                    .any(|(j, flap)| j != prev && j != k && !apart(pin, flap))
+            })
+        })
+    };
+    // First one pin at every corner that can hold one, with the shallowest flaps; then
+    // corner by corner the wanted count, where the deeper flaps it takes do not cover
+    // another corner's pins.
+    let mut corners: Vec<Corner> = (0..n)
+        .map(|k| {
+            plan(k, panel.holes.min(1)).unwrap_or_else(|| {
+                let (centre, _) = corner_pins(k, depths[0], 0);
+                Corner {
+                    depth: depths[0],
+                    centre,
+                    pins: Vec::new(),
+                }
+            })
+        })
+        .collect();
+    if panel.holes > 1 {
+        for k in 0..n {
+            if let Some(full) = plan(k, panel.holes) {
+                let mut tried = corners.clone();
+                tried[k] = full;
+                if !conflicts(&tried) {
+                    corners = tried;
+                }
+            }
+        }
+    }
+    let depth_of = flap_depths(&corners);
+    let flaps: Vec<Vec<DVec2>> = (0..n).map(|k| flap_at(k, depth_of[k])).collect();
+
+    let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
+    for flap in &flaps {
+        parts.push_flap(flap.iter().skip(2).map(|&q| frame.to3(q)));
+    }
+    for (k, corner) in corners.into_iter().enumerate() {
+        let prev = (k + n - 1) % n;
+        parts.set_corner_label(k, frame.to3(corner.centre));
+        parts.grown += usize::from(corner.depth > options.flap_scale);
+        let pins: Vec<DVec2> = corner
+            .pins
+            .into_iter()
+            .filter(|&pin| {
+                flaps
+                    .iter()
+                    .enumerate()
+                    .all(|(j, flap)| j == prev || j == k || apart(pin, flap))
+            })
+            .collect();
+        parts.reduced += usize::from((pins.len() as u32) < panel.holes);
+        parts.bare += usize::from(panel.holes > 0 && pins.is_empty());
         // The connection at corner k is named by the half-edge leaving it; both flaps
         // meeting there carry its holes.
         let connection = half_edges[k].0;

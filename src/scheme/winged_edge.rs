@@ -178,13 +178,7 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions, shift: i32) -> Face
         let centre = region.iter().copied().sum::<DVec2>() / region.len() as f64;
         // Pins along the band edge the region lies on.
         let along = region[1] - region[0];
-        let (pins, fewer) = place_pins(
-            region,
-            centre,
-            along,
-            options.panel.holes,
-            options.panel.hole_diameter,
-        );
+        let (pins, fewer) = place_pins(region, centre, along, options.panel.holes, &options.panel);
         short_at_corner[*corner] |= fewer;
         placed_at_corner[*corner] += pins.len();
         let connection = half_edges[*corner].0;

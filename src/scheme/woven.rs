@@ -1159,9 +1159,9 @@ fn joint_holes(
     let mut centres: Vec<DVec2> = Vec::new();
     for &f in fractions {
         let q = ma.lerp(mb, f);
-        // A hole radius of material around the hole, and a diameter between holes.
+        // The margin of material around the hole, and a diameter between holes.
         if !contains(&outline, q)
-            || distance_to_border(&outline, q) < 2.0 * radius
+            || distance_to_border(&outline, q) < radius + options.panel.hole_margin
             || centres.iter().any(|c| c.distance(q) < 4.0 * radius)
         {
             continue;
