@@ -116,8 +116,9 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
     let panel = &options.panel;
-    // Inner line of band edge k at depth `depth`, directed like the edge, through the
-    // band corners moved toward the centre (the frame's origin). The flap is the band
+    // Inner line of band edge k at depth `depth`: parallel to the edge and directed
+    // like it, through band corner k moved `depth` of the way to the centre (the
+    // frame's origin; beyond it for depths over 1). The flap is the band
     // clipped to the strip between its edge and that line: the same as running its
     // sides along the neighbouring band edges, and it never leaves the band when a
     // neighbouring edge is nearly parallel (sliver triangles).
