@@ -105,6 +105,28 @@ pub(crate) fn parse_length_unbounded(text: &str) -> std::result::Result<f64, Str
     Ok(value * unit.mm())
 }
 
+/// A positive length option (`--tab-height`): `text` or else `default`, in mm.
+pub fn positive_length(option: &str, text: Option<&str>, default: &str) -> Result<f64, String> {
+    let text = text.unwrap_or(default);
+    match parse_length(text) {
+        Ok(mm) if mm > 0.0 => Ok(mm),
+        Ok(_) => Err(format!("--{option}: '{text}' must be positive")),
+        Err(e) => Err(format!("--{option}: {e}")),
+    }
+}
+
+/// A fraction option in (0, 1]: `value` or else `default`.
+pub fn fraction(option: &str, value: Option<f64>, default: f64) -> Result<f64, String> {
+    let x = value.unwrap_or(default);
+    if x > 0.0 && x <= 1.0 {
+        Ok(x)
+    } else {
+        Err(format!(
+            "--{option}: {x} must be greater than 0 and at most 1"
+        ))
+    }
+}
+
 /// A number for a message: [`fmt_num`] when moderate, exponent form when huge or tiny
 /// (f64's `{}` would print 1e300 with 301 digits).
 pub(crate) fn short_number(x: f64) -> String {

@@ -78,7 +78,7 @@ impl Scheme for Toy {
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
         let args: ToyArgs = values.parse()?;
-        let shrink = unfold::scheme::fraction("toy-shrink", args.toy_shrink, 0.9)?;
+        let shrink = unfold::units::fraction("toy-shrink", args.toy_shrink, 0.9)?;
         Ok(Box::new(ToyOptions { panel, shrink }))
     }
 }
@@ -117,10 +117,6 @@ impl Configured for ToyOptions {
         let mut params = Params::default();
         params.push("toy_shrink", self.shrink);
         params
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 

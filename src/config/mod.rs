@@ -16,8 +16,8 @@ use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Re
 mod file;
 pub use file::load_config;
 
+use crate::units::{fraction, parse_length_unbounded, positive_length, split_number};
 pub use crate::units::{parse_length, LengthUnit, MAX_LENGTH_MM, MM_PER_INCH};
-use crate::units::{parse_length_unbounded, split_number};
 
 /// A sheet of material.
 #[derive(Clone, Debug, PartialEq)]
@@ -387,8 +387,8 @@ pub struct BuildOptions {
     pub hole_diameter: Option<String>,
 
     /// Material kept between a fastener hole's rim and every cut edge of the panels it
-    /// goes through, and between two holes, with a unit; half a hole diameter lets a
-    /// fastener head of twice the hole's diameter bear on material all round.
+    /// goes through, with a unit; half a hole diameter lets a fastener head of twice
+    /// the hole's diameter bear on material all round.
     /// [default: half the --hole-diameter]
     #[arg(long, value_name = "LENGTH")]
     pub hole_margin: Option<String>,
@@ -650,13 +650,7 @@ impl BuildOptions {
             ),
         };
         let length = |option: &str, value: &Option<String>, default: &str| {
-            let text = value.as_deref().unwrap_or(default);
-            let mm = parse_length(text).map_err(|e| usage(option, e))?;
-            if mm > 0.0 {
-                Ok(mm)
-            } else {
-                Err(usage(option, format!("'{text}' must be positive")))
-            }
+            positive_length(option, value.as_deref(), default).map_err(Error::Usage)
         };
         let scheme = match self.scheme.as_deref() {
             None => registry.default_scheme(),
@@ -694,13 +688,8 @@ impl BuildOptions {
             ));
         }
         let defaults = scheme.defaults();
-        let face_scale = self.face_scale.unwrap_or(defaults.face_scale);
-        if !(face_scale > 0.0 && face_scale <= 1.0) {
-            return Err(usage(
-                "face-scale",
-                format!("{face_scale} must be greater than 0 and at most 1"),
-            ));
-        }
+        let face_scale =
+            fraction("face-scale", self.face_scale, defaults.face_scale).map_err(Error::Usage)?;
         let holes = self.holes.unwrap_or(defaults.holes);
         if !defaults.holes_allowed.contains(&holes) {
             return Err(usage(

@@ -8,11 +8,12 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::{face_band, fraction, PanelDefaults, PanelOptions};
+use super::{face_band, PanelDefaults, PanelOptions};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
 use crate::record::Params;
+use crate::units::fraction;
 
 /// The edge schemes' defaults for the shared options: bands halfway to the face
 /// centre leave room for the flaps, and two pins per corner keep a connection from

@@ -157,7 +157,11 @@ impl Scheme for HalfEdge {
         Ok(Box::new(HalfEdgeOptions {
             panel,
             tabs: args.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
-            tab_height: super::positive_length("tab-height", args.tab_height.as_deref(), "8mm")?,
+            tab_height: crate::units::positive_length(
+                "tab-height",
+                args.tab_height.as_deref(),
+                "8mm",
+            )?,
         }))
     }
 }
@@ -176,10 +180,6 @@ impl Configured for HalfEdgeOptions {
         params.push("connectors", if self.tabs { "tab" } else { "none" });
         params.push("tab_height", round4(self.tab_height));
         params
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 

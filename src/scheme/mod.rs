@@ -57,15 +57,26 @@ pub trait Scheme: Send + Sync {
 }
 
 /// A scheme with its options resolved, ready to build panels.
-pub trait Configured: fmt::Debug + Send + Sync + Any {
+pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     /// The options every scheme takes, as resolved.
     fn panel(&self) -> &PanelOptions;
     /// Builds the panels of `mesh` (millimetres, faces as the scheme needs them).
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError>;
     /// Its own options as used, for the manifest's `scheme.params` (lengths in mm).
     fn params(&self) -> Params;
-    /// For callers that know the concrete type (tests, benches).
+}
+
+/// The concrete options behind a [`Configured`], for callers that know their type
+/// (tests, benches); every type has it, so a scheme writes nothing for it.
+pub trait AsAny {
+    /// `self` as [`Any`].
     fn as_any(&self) -> &dyn Any;
+}
+
+impl<T: Any> AsAny for T {
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
 }
 
 /// Defaults a scheme gives the options every scheme takes.
@@ -89,7 +100,7 @@ pub struct PanelOptions {
     /// Hole diameter (mm).
     pub hole_diameter: f64,
     /// Material kept between a hole's rim and any cut edge of the panels it goes
-    /// through, and between the rims of two holes of a connection (mm).
+    /// through (mm); two holes of a connection keep one diameter between their rims.
     pub hole_margin: f64,
     /// Wanted label cap height (mm).
     pub label_height: f64,
@@ -184,28 +195,6 @@ impl OptionValues {
                 .to_string()
         })?;
         T::from_arg_matches(&matches).map_err(|e| e.to_string())
-    }
-}
-
-/// A positive length option (`--tab-height`): `text` or else `default`, in mm.
-pub fn positive_length(option: &str, text: Option<&str>, default: &str) -> Result<f64, String> {
-    let text = text.unwrap_or(default);
-    match crate::units::parse_length(text) {
-        Ok(mm) if mm > 0.0 => Ok(mm),
-        Ok(_) => Err(format!("--{option}: '{text}' must be positive")),
-        Err(e) => Err(format!("--{option}: {e}")),
-    }
-}
-
-/// A fraction option in (0, 1]: `value` or else `default`.
-pub fn fraction(option: &str, value: Option<f64>, default: f64) -> Result<f64, String> {
-    let x = value.unwrap_or(default);
-    if x > 0.0 && x <= 1.0 {
-        Ok(x)
-    } else {
-        Err(format!(
-            "--{option}: {x} must be greater than 0 and at most 1"
-        ))
     }
 }
 
@@ -336,7 +325,8 @@ impl ConfiguredScheme {
 
     /// The scheme's own options, when they are a `T`.
     pub fn options_as<T: 'static>(&self) -> Option<&T> {
-        self.options.as_any().downcast_ref::<T>()
+        // Through the trait object: the `Arc` itself is `Any` too.
+        AsAny::as_any(&*self.options).downcast_ref::<T>()
     }
 
     /// Builds the panels of `mesh`.
@@ -387,22 +377,22 @@ pub struct SchemeOutput {
     pub manifest: Params,
 }
 
-/// Errors a scheme reports (options it cannot honour).
+/// Errors a scheme reports, each message naming its fix (the scheme's file writes
+/// them).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SchemeError {
-    /// The weave cannot be traced (a mesh with boundary).
-    #[error("the woven scheme cannot weave this mesh: {0}; close the holes of the mesh or use another --scheme")]
-    Weave(String),
-    /// A ribbon piece larger than the largest panel the sheet takes.
-    #[error("cycle {cycle}: one edge crossing of its ribbon is {size:.1} mm across and does not fit the sheet; use a larger --sheet or a smaller --size")]
-    TooLarge { cycle: String, size: f64 },
+    /// The job's options do not suit the model (exit code 2).
+    #[error("{0}")]
+    Options(String),
+    /// The model cannot be built by the scheme at this size (exit code 1).
+    #[error("{0}")]
+    Model(String),
 }
 
 impl SchemeError {
-    /// True when the job's options are at fault (exit code 2); otherwise the model
-    /// does not suit the scheme at this size.
+    /// True when the job's options are at fault (exit code 2).
     pub fn is_usage(&self) -> bool {
-        matches!(self, SchemeError::Weave(_))
+        matches!(self, SchemeError::Options(_))
     }
 }
 

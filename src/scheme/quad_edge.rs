@@ -78,10 +78,6 @@ impl Configured for EdgeOptions {
     fn params(&self) -> Params {
         EdgeOptions::params(self)
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// Builds the edge panels of a mesh whose faces are planar and convex.

@@ -102,10 +102,6 @@ impl Configured for WingedEdgeOptions {
         params.push("shift", self.shift);
         params
     }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
 }
 
 /// Builds the winged edge panels of a mesh whose faces are planar and convex.

@@ -26,7 +26,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::{args_of, fraction, Configured, OptionValues, PanelDefaults, PanelOptions};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
@@ -37,6 +37,7 @@ use crate::plane::{
     segment_distance, smallest_box,
 };
 use crate::record::{round4, Params};
+use crate::units::fraction;
 
 /// The woven scheme: plain-weaving ribbons from the extended graph rotation system.
 pub struct Woven;
@@ -162,10 +163,6 @@ impl Configured for WovenOptions {
         params.push("thickness", round4(self.thickness));
         params.push("curl_limit", self.curl_limit);
         params
-    }
-
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
     }
 }
 
@@ -478,7 +475,11 @@ pub fn ribbons(
     options: &WovenOptions,
 ) -> Result<(Vec<Ribbon>, RibbonNotes), SchemeError> {
     let cycles = trace_cycles(mesh, &vec![true; mesh.edge_count()])
-        .map_err(|e| SchemeError::Weave(e.to_string()))?;
+        .map_err(|e| {
+            SchemeError::Options(format!(
+                "the woven scheme cannot weave this mesh: {e}; close the holes of the mesh or use another --scheme"
+            ))
+        })?;
     // The cycles crossing each edge (twice each).
     let mut visits: Vec<Vec<u32>> = vec![Vec::new(); mesh.edge_count()];
     for (c, cycle) in cycles.iter().enumerate() {
@@ -902,10 +903,11 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
                 let points: Vec<DVec3> = (start..=start + pieces)
                     .flat_map(|l| r.lines[l % ring])
                     .collect();
-                SchemeError::TooLarge {
-                    cycle: cycle_id(r.cycle).to_string(),
-                    size: crate::mesh::geometry::diameter(&points),
-                }
+                SchemeError::Model(format!(
+                    "cycle {}: one edge crossing of its ribbon is {:.1} mm across and does not fit the sheet; use a larger --sheet or a smaller --size",
+                    cycle_id(r.cycle),
+                    crate::mesh::geometry::diameter(&points)
+                ))
             })
         })
         .collect::<Vec<_>>()
