@@ -491,29 +491,6 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     })
 }
 
-/// How many connections have 0, 1, 2 … fastener holes: each hole goes through both
-/// panels of its connection, so a connection's holes are half the flat holes naming it.
-fn connections_by_holes(
-    flat: &FlatPanels,
-    connections: usize,
-) -> std::collections::BTreeMap<String, usize> {
-    let mut holes_of: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
-    for p in flat.iter() {
-        for hole in p.holes {
-            *holes_of.entry(hole.connection).or_default() += 1;
-        }
-    }
-    let mut by_holes = std::collections::BTreeMap::new();
-    let bare = connections.saturating_sub(holes_of.len());
-    if bare > 0 || holes_of.is_empty() {
-        by_holes.insert("0".to_string(), bare);
-    }
-    for count in holes_of.values() {
-        *by_holes.entry((count / 2).to_string()).or_default() += 1;
-    }
-    by_holes
-}
-
 fn build_manifest(
     job: &Job,
     prepared: &Prepared,
@@ -581,7 +558,7 @@ fn build_manifest(
             sheets_spacing_bound: nested.spacing_bound,
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
-            connections_by_holes: connections_by_holes(flat, output.connections),
+            connections_by_holes: manifest::connections_by_holes(flat, output.connections),
             fasteners: flat.iter().map(|p| p.holes.len()).sum::<usize>() / 2,
             labels_left_out: labels_left_out.total(),
             panel_ids_left_out: labels_left_out.panel,
