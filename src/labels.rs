@@ -5,7 +5,10 @@
 use glam::DVec2;
 
 use crate::font::text_width;
-use crate::panel::{box_area, FacetFrame, FlatLabel, FlatPanel, LabelKind, LoopsRef, PanelRef};
+use crate::panel::{
+    box_area, label_extent, FacetFrame, FlatLabel, FlatPanel, LabelKind, LoopsRef, PanelRef,
+    FRAME_PAD, TIGHT_FRAME_PAD,
+};
 pub use crate::panel::{LeftOut, MIN_HEIGHT};
 use crate::plane::{contains, distance_to_border, polygons_touch, segments_intersect};
 
@@ -25,6 +28,14 @@ impl Default for LabelOptions {
 /// Shrink factor per attempt.
 const SHRINK: f64 = 0.9;
 
+/// How many times labels are fitted again to give each kind one height.
+const HEIGHT_PASSES: usize = 3;
+
+/// Where a sliding partner id is tried along its reading direction, in parts of its
+/// slide, nearest its anchor first; other labels try [`COARSE_SLIDES`].
+const SLIDES: [f64; 9] = [0.0, -0.25, 0.25, -0.5, 0.5, -0.75, 0.75, -1.0, 1.0];
+const COARSE_SLIDES: [f64; 5] = [0.0, -0.5, 0.5, -1.0, 1.0];
+
 /// The text box of a label: corners counter-clockwise (baseline first).
 pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [DVec2; 4] {
     let along = 0.5 * width * direction;
@@ -37,21 +48,75 @@ pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [D
     ]
 }
 
+/// Free space kept between two labels, in cap heights of the taller one: about a word
+/// space, so neighbouring ids never read as one ("E587 F371", not "E587F371").
+pub const LABEL_GAP: f64 = 0.4;
+
 /// Fits the labels a scheme wants on a panel (the 3D panel `source`'s labels, mapped
 /// through the facet frames of its unrolling); returns how many of each kind were
 /// left out. Panel ids go first, then partner ids, then marks, so the important ones
-/// get the room.
+/// get the room. Labels of one kind share one height where room allows: when a fit
+/// gives them different heights, they are fitted again at most at the smallest, and
+/// the new fit is kept unless it leaves more of some kind out.
 pub fn fit_labels(
     panel: &mut FlatPanel,
     source: PanelRef,
     frames: &[FacetFrame],
     options: LabelOptions,
 ) -> LeftOut {
+    let mut chosen = fit_pass(panel, source, frames, options, [f64::INFINITY; 3]);
+    for _ in 0..HEIGHT_PASSES {
+        let mut smallest = [f64::INFINITY; 3];
+        let mut largest = [0.0f64; 3];
+        for label in &chosen.labels {
+            let k = kind_index(label.kind);
+            smallest[k] = smallest[k].min(label.height);
+            largest[k] = largest[k].max(label.height);
+        }
+        if (0..3).all(|k| largest[k] <= smallest[k] * (1.0 + 1e-9)) {
+            break;
+        }
+        let next = fit_pass(panel, source, frames, options, smallest);
+        let keeps_all = [LabelKind::Panel, LabelKind::Partner, LabelKind::Mark]
+            .into_iter()
+            .all(|kind| next.dropped.of(kind) <= chosen.dropped.of(kind));
+        if !keeps_all {
+            break;
+        }
+        chosen = next;
+    }
+    panel.labels = chosen.labels;
+    chosen.dropped
+}
+
+/// Slot of a kind in per-kind arrays.
+fn kind_index(kind: LabelKind) -> usize {
+    match kind {
+        LabelKind::Panel => 0,
+        LabelKind::Partner => 1,
+        LabelKind::Mark => 2,
+    }
+}
+
+/// The labels one fitting pass placed, and how many it left out.
+struct Fitted {
+    labels: Vec<FlatLabel>,
+    dropped: LeftOut,
+}
+
+/// One fitting pass, each label at most at its wanted height and at its kind's cap.
+fn fit_pass(
+    panel: &FlatPanel,
+    source: PanelRef,
+    frames: &[FacetFrame],
+    options: LabelOptions,
+    caps: [f64; 3],
+) -> Fitted {
     let wanted_labels = source.labels;
     let facets = source.facets;
     let mut order: Vec<usize> = (0..wanted_labels.len()).collect();
     order.sort_by_key(|&i| (wanted_labels[i].kind, i));
-    let mut placed: Vec<[DVec2; 4]> = Vec::new();
+    let mut placed: Vec<Placed> = Vec::new();
     let mut labels = Vec::new();
     let mut dropped = source.labels_dropped;
     for i in order {
@@ -64,39 +129,64 @@ pub fn fit_labels(
             on_edge: wanted.on_edge,
             slide: wanted.slide,
         }];
-        if wanted.kind == LabelKind::Panel {
+        let is_panel = wanted.kind == LabelKind::Panel;
+        if is_panel {
             // A panel without its id cannot be found: if the wanted place is too
             // small, try the panel's largest facets.
             attempts.extend(fallback_attempts(panel, facets, wanted.facet as usize));
         }
-        let text_width = text_width(wanted.text);
-        let fitted = attempts.iter().find_map(|attempt| {
-            fit_one(
-                panel,
-                facets,
-                attempt,
-                text_width,
-                wanted.height,
-                &placed,
-                options,
-            )
+        let text = Text {
+            frame: 0.0,
+            thorough: wanted.kind == LabelKind::Partner,
+            width: text_width(wanted.text),
+            height: wanted.height.min(caps[kind_index(wanted.kind)]),
+        };
+        // A panel id is framed; on a panel too small for the frame, tightly framed,
+        // and only on one too small for that, unframed rather than missing.
+        let frames: &[f64] = if is_panel {
+            &[FRAME_PAD, TIGHT_FRAME_PAD, 0.0]
+        } else {
+            &[0.0]
+        };
+        let fitted = frames.iter().find_map(|&frame| {
+            let text = Text { frame, ..text };
+            attempts.iter().find_map(|attempt| {
+                fit_one(panel, facets, attempt, text, &placed, options).map(|fit| (fit, frame))
+            })
         });
         match fitted {
-            Some((center, direction, height, bx)) => {
-                placed.push(bx);
+            Some(((center, direction, height, bx), frame)) => {
+                placed.push(Placed { bx, height });
                 labels.push(FlatLabel {
                     text: wanted.text,
                     center,
                     direction,
                     height,
                     kind: wanted.kind,
+                    frame,
                 });
             }
             None => dropped.count(wanted.kind),
         }
     }
-    panel.labels = labels;
-    dropped
+    Fitted { labels, dropped }
+}
+
+/// What is being fitted: its frame (see [`FlatLabel::frame`]), its text width at cap
+/// height 1 and the largest cap height it may have.
+#[derive(Clone, Copy)]
+struct Text {
+    frame: f64,
+    width: f64,
+    height: f64,
+    /// Searched at more places (partner ids: what the builder pairs panels by).
+    thorough: bool,
+}
+
+/// A label already placed: its box and cap height.
+struct Placed {
+    bx: [DVec2; 4],
+    height: f64,
 }
 
 /// One place to try a label.
@@ -147,15 +237,14 @@ fn fallback_attempts(panel: &FlatPanel, facets: LoopsRef, skip: usize) -> Vec<At
         .collect()
 }
 
-/// The largest height (from `wanted` down, shrinking) and position at which a label
-/// fits in its attempt's facet: (centre, direction, height, box).
+/// The largest height (from the text's height down, shrinking) and position at which
+/// a label fits in its attempt's facet: (centre, direction, height, box).
 fn fit_one(
     panel: &FlatPanel,
     facets: LoopsRef,
     attempt: &Attempt,
-    text_width: f64,
-    wanted: f64,
-    placed: &[[DVec2; 4]],
+    text: Text,
+    placed: &[Placed],
     options: LabelOptions,
 ) -> Option<(DVec2, DVec2, f64, [DVec2; 4])> {
     let direction = attempt.direction;
@@ -167,11 +256,13 @@ fn fit_one(
         .map(|&k| panel.points[k as usize])
         .collect();
     // Positions along the reading direction, nearest the anchor first.
+    let steps: &[f64] = if text.thorough {
+        &SLIDES
+    } else {
+        &COARSE_SLIDES
+    };
     let slides: Vec<f64> = if attempt.slide > 0.0 {
-        [0.0, -0.5, 0.5, -1.0, 1.0]
-            .iter()
-            .map(|f| f * attempt.slide)
-            .collect()
+        steps.iter().map(|f| f * attempt.slide).collect()
     } else {
         vec![0.0]
     };
@@ -179,21 +270,33 @@ fn fit_one(
     // larger are skipped untested (the same heights are visited, so the result is
     // that of testing them all). Most labels of tiny panels fail here at once.
     let room = crate::plane::area(&facet);
-    let mut height = wanted;
-    while height >= MIN_HEIGHT && box_area(text_width, height) > room {
+    let mut height = text.height;
+    while height >= MIN_HEIGHT && box_area(text.frame, text.width, height) > room {
         height *= SHRINK;
     }
     while height >= MIN_HEIGHT {
-        for &shift in &slides {
-            let mut center = attempt.anchor + shift * direction;
-            if attempt.on_edge {
-                // Twice the margin off the edge: the fit test wants at least one
-                // margin, and rounding must not make an exact margin fail every size.
-                center += (2.0 * options.margin + 0.5 * height) * direction.perp();
-            }
-            let bx = label_box(center, direction, text_width * height, height);
-            if box_fits(&bx, &facet, panel, placed, options.margin) {
-                return Some((center, direction, height, bx));
+        let (width, across) = label_extent(text.frame, text.width, height);
+        // A sliding partner id may also step sideways by up to its own height, round
+        // holes and labels placed before it; an edge label keeps to its edge.
+        let sideways: &[f64] = if text.thorough && attempt.slide > 0.0 && !attempt.on_edge {
+            &[0.0, -0.5, 0.5, -1.0, 1.0]
+        } else {
+            &[0.0]
+        };
+        for &side in sideways {
+            for &shift in &slides {
+                let mut center =
+                    attempt.anchor + shift * direction + side * height * direction.perp();
+                if attempt.on_edge {
+                    // Twice the margin off the edge: the fit test wants at least one
+                    // margin, and rounding must not make an exact margin fail every
+                    // size.
+                    center += (2.0 * options.margin + 0.5 * across) * direction.perp();
+                }
+                let bx = label_box(center, direction, width, across);
+                if box_fits(&bx, height, &facet, panel, placed, options.margin) {
+                    return Some((center, direction, height, bx));
+                }
             }
         }
         height *= SHRINK;
@@ -203,9 +306,10 @@ fn fit_one(
 
 fn box_fits(
     bx: &[DVec2; 4],
+    height: f64,
     facet: &[DVec2],
     panel: &FlatPanel,
-    placed: &[[DVec2; 4]],
+    placed: &[Placed],
     margin: f64,
 ) -> bool {
     // Inside the facet, away from its border.
@@ -234,10 +338,10 @@ fn box_fits(
             return false;
         }
     }
-    // Clear of labels already placed (their boxes grown by the margin).
+    // Clear of labels already placed: their boxes grown by the gap between labels.
     placed.iter().all(|other| {
-        let grown = grow(other, margin);
-        !polygons_touch(bx, &grown)
+        let gap = margin.max(LABEL_GAP * height.max(other.height));
+        !polygons_touch(bx, &grow(&other.bx, gap))
     })
 }
 
@@ -305,7 +409,7 @@ mod tests {
             // Wanted below the legible height: never tried.
             label(Name::Face(9), LabelKind::Mark, 0, 1.0, on_square),
         ];
-        assert!(box_area(text_width(Name::Edge(123)), MIN_HEIGHT) > 1.01 * 4.0);
+        assert!(box_area(0.0, text_width(Name::Edge(123)), MIN_HEIGHT) > 1.01 * 4.0);
         let pruned = square_and_strip(wanted.clone());
         let kinds: Vec<LabelKind> = pruned.labels.iter().map(|l| l.kind).collect();
         assert_eq!(kinds, [LabelKind::Panel, LabelKind::Mark]);

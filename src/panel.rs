@@ -12,6 +12,7 @@ use crate::font::text_width;
 use crate::mesh::geometry::vector_area;
 
 mod arena;
+pub mod surface;
 
 use arena::{arena_len, collect_arena};
 pub use arena::{fill_arena, Arena, ArenaIter, Views};
@@ -701,6 +702,9 @@ pub struct FlatLabel {
     pub height: f64,
     /// Panel id or partner id.
     pub kind: LabelKind,
+    /// How far the frame engraved round it stands off its text, in cap heights (a
+    /// panel's own id); 0: no frame.
+    pub frame: f64,
 }
 
 /// A panel unrolled into the plane, outside face up (its facets counter-clockwise).
@@ -1039,7 +1043,7 @@ pub(crate) fn drop_unfittable(
         };
         // 1 % of slack for the rounding between the 3D and the flat areas.
         let fits = label.height >= MIN_HEIGHT
-            && box_area(text_width(label.text), MIN_HEIGHT) <= 1.01 * room;
+            && box_area(0.0, text_width(label.text), MIN_HEIGHT) <= 1.01 * room;
         if !fits {
             dropped.count(label.kind);
         }
@@ -1048,11 +1052,26 @@ pub(crate) fn drop_unfittable(
     dropped
 }
 
-/// The area of a label's box at cap height `height` ([`label_box`] of width
-/// `text_width * height`): what the early drop and the height skip compare with a
-/// facet's area.
-pub(crate) fn box_area(text_width: f64, height: f64) -> f64 {
-    text_width * height * height
+/// How far the frame engraved around a panel's own id stands off its text, in cap
+/// heights: the frame tells the panel's id from the partner ids beside it.
+pub const FRAME_PAD: f64 = 0.25;
+
+/// The frame of a panel id on a panel too small for [`FRAME_PAD`]: nearer the text,
+/// but still a frame.
+pub const TIGHT_FRAME_PAD: f64 = 0.1;
+
+/// The size (along the text, across it) of what a label engraves at cap height
+/// `height`: its text, and the frame `frame` cap heights off it (0: none).
+pub fn label_extent(frame: f64, text_width: f64, height: f64) -> (f64, f64) {
+    let (w, h) = (text_width * height, height);
+    (w + 2.0 * frame * h, h + 2.0 * frame * h)
+}
+
+/// The area of a label's box at cap height `height` ([`label_extent`]): what the
+/// early drop and the height skip compare with a facet's area.
+pub(crate) fn box_area(frame: f64, text_width: f64, height: f64) -> f64 {
+    let (w, h) = label_extent(frame, text_width, height);
+    w * h
 }
 
 /// How many labels of each kind were left out.
@@ -1070,6 +1089,15 @@ impl LeftOut {
     /// All kinds together.
     pub fn total(&self) -> usize {
         self.panel + self.partner + self.mark
+    }
+
+    /// How many of one kind.
+    pub fn of(&self, kind: LabelKind) -> usize {
+        match kind {
+            LabelKind::Panel => self.panel,
+            LabelKind::Partner => self.partner,
+            LabelKind::Mark => self.mark,
+        }
     }
 
     pub(crate) fn count(&mut self, kind: LabelKind) {

@@ -427,6 +427,17 @@ pub fn export(
         format!("{name}-assembled.obj"),
         assembled_obj(&output.panels).into_bytes(),
     ));
+    if job.map {
+        let surface =
+            crate::panel::surface::panel_surface(&prepared.scheme_mesh.mesh, &output.panels);
+        let map = crate::export::map::assembly_map(&crate::export::map::MapInput {
+            surface: &surface,
+            panels: &output.panels,
+            layout,
+            name: &name,
+        });
+        files.push((format!("{name}-map.svg"), map.into_bytes()));
+    }
     manifest.warnings = warnings;
     manifest.files = files
         .iter()

@@ -180,8 +180,10 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
             budget_edges < 8784,
             "{scheme}: {budget_edges} edges suggested"
         );
-        // The suggested budget, run, carries the panels' ids: no warning, and at most
-        // the checked fraction (1 %) of ids left out.
+        // The suggested budget, run, carries every panel's id and nearly every
+        // partner id, with no warning: the budget is worked out for even faces, and
+        // the smaller faces a simplified mesh keeps lose a partner id, so at most 5 %
+        // of them may be left out.
         let mut suggested = args.to_vec();
         suggested.extend(["--target-edges", &budget, "--strict", "--quiet"]);
         let run = build(&spot, &out, &suggested);
@@ -194,9 +196,15 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
         let manifest = read_manifest(&out);
         let panels = count(&manifest, "counts.panels");
         let ids_out = count(&manifest, "counts.panel_ids_left_out");
-        assert!(
-            ids_out * 100 <= panels,
+        assert_eq!(
+            ids_out, 0,
             "{scheme} at {budget} edges: {ids_out} of {panels} panel ids left out"
+        );
+        let partners = 2 * count(&manifest, "counts.connections");
+        let partners_out = count(&manifest, "counts.partner_ids_left_out");
+        assert!(
+            partners_out * 20 <= partners,
+            "{scheme} at {budget} edges: {partners_out} of {partners} partner ids left out"
         );
         assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");
     }

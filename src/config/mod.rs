@@ -369,6 +369,12 @@ pub struct BuildOptions {
     #[serde(default)]
     pub force: bool,
 
+    /// Write no assembly map (NAME-map.svg: the model from six sides, each panel's id
+    /// where it sits, tinted by its sheet). [default: the map is written]
+    #[arg(long)]
+    #[serde(default)]
+    pub no_map: bool,
+
     /// Output formats, comma separated: svg, dxf. [default: svg]
     #[arg(long, value_name = "LIST")]
     pub format: Option<String>,
@@ -503,6 +509,8 @@ pub struct Job {
     pub out: PathBuf,
     /// Write into an output folder holding other files, keeping them.
     pub force: bool,
+    /// Write the assembly map beside the sheets.
+    pub map: bool,
     /// Refuse instead of warning about the build's size.
     pub strict: bool,
     /// Print the summary as JSON on stdout.
@@ -587,6 +595,7 @@ impl BuildOptions {
             spacing: self.spacing.or(other.spacing),
             out: self.out.or(other.out),
             force: self.force || other.force,
+            no_map: self.no_map || other.no_map,
             format: self.format.or(other.format),
             face_scale: self.face_scale.or(other.face_scale),
             holes: self.holes.or(other.holes),
@@ -783,6 +792,7 @@ impl BuildOptions {
             spacing,
             out,
             force: self.force,
+            map: !self.no_map,
             strict: self.strict,
             json: self.json,
             quiet: self.quiet,

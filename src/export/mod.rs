@@ -6,6 +6,7 @@
 pub mod dxf;
 pub mod folder;
 pub mod manifest;
+pub mod map;
 pub mod obj;
 pub mod report;
 pub mod svg;
@@ -14,7 +15,7 @@ use glam::DVec2;
 
 use crate::font::text_strokes;
 use crate::nest::{Layout, Placement};
-use crate::panel::{FlatPanelRef, FlatPanels};
+use crate::panel::{label_extent, FlatPanelRef, FlatPanels};
 
 /// The three kinds of laser geometry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -185,7 +186,7 @@ pub fn draw_sheet(layout: &Layout, index: usize, panels: &FlatPanels, sink: &mut
 }
 
 /// A label's strokes: scaled to its cap height, its box centred on the label centre,
-/// reading along its direction.
+/// reading along its direction; a panel's own id framed.
 fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetSink) {
     for label in panel.labels {
         let strokes = text_strokes(label.text);
@@ -204,6 +205,18 @@ fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetS
                 .map(|q| origin + q.x * h * d + q.y * h * up)
                 .collect();
             sink.polyline(Kind::Engrave, &points, false);
+        }
+        if label.frame > 0.0 {
+            let (w, across) = label_extent(label.frame, strokes.width, h);
+            let center = placement.apply(label.center);
+            let (along, side) = (0.5 * w * d, 0.5 * across * up);
+            let frame = [
+                center - along - side,
+                center + along - side,
+                center + along + side,
+                center - along + side,
+            ];
+            sink.polyline(Kind::Engrave, &frame, true);
         }
     }
 }

@@ -323,9 +323,12 @@ impl Sheets {
 pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     let spec = sheet_spec(manifest);
     let names = entry_names(out);
+    // The sheets are the SVG and DXF files of the folder but the assembly map (a
+    // picture for people, checked in tests/map.rs).
+    let is_map = |n: &String| n.ends_with("-map.svg");
     let svg_files: Vec<String> = names
         .iter()
-        .filter(|n| n.ends_with(".svg"))
+        .filter(|n| n.ends_with(".svg") && !is_map(n))
         .cloned()
         .collect();
     let dxf_files: Vec<String> = names
@@ -333,6 +336,22 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
         .filter(|n| n.ends_with(".dxf"))
         .cloned()
         .collect();
+    let listed: BTreeSet<String> = manifest["sheets"]
+        .as_array()
+        .map(|sheets| {
+            sheets
+                .iter()
+                .flat_map(|s| s["files"].as_array().cloned().unwrap_or_default())
+                .filter_map(|f| f.as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default();
+    for name in svg_files.iter().chain(&dxf_files) {
+        assert!(
+            listed.contains(name),
+            "{name}: a sheet file the manifest's sheets do not list"
+        );
+    }
     let mut stats = Vec::new();
     for name in &svg_files {
         let text = std::fs::read_to_string(out.join(name)).unwrap();
@@ -408,10 +427,14 @@ pub fn check_output(
     let sheets = count(m, "counts.sheets");
     assert!(sheets >= 1, "{what}: no sheets");
 
-    // The files: one SVG and one DXF per sheet, the manifest and the assembled model.
+    // The files: one SVG and one DXF per sheet, the manifest, the assembled model and
+    // the assembly map.
     let digits = sheets.to_string().len().max(2);
-    let mut expected =
-        BTreeSet::from(["manifest.json".to_string(), format!("{name}-assembled.obj")]);
+    let mut expected = BTreeSet::from([
+        "manifest.json".to_string(),
+        format!("{name}-assembled.obj"),
+        format!("{name}-map.svg"),
+    ]);
     for k in 1..=sheets {
         expected.insert(format!("{name}-{k:0digits$}.svg"));
         expected.insert(format!("{name}-{k:0digits$}.dxf"));
