@@ -473,17 +473,24 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     }
     clock.lap("split");
     let output = scheme(job, &prepared)?;
+    let fastening = crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output);
+    // Under --strict it is a refusal after the label check (which may refuse first).
+    if let (Some(warning), false) = (&fastening, job.strict) {
+        warn(warning);
+    }
     clock.lap("scheme");
     let flat = flatten(job, &prepared, &output)?;
     if let Some(warning) = &flat.warning {
         warn(warning);
     }
+    crate::sanity::refuse_unfastened(job, fastening.as_ref())?;
     clock.lap("flatten");
     let nested = nest(job, &flat)?;
     clock.lap("nest");
     let warnings: Vec<String> = prepared
         .warnings
         .iter()
+        .chain(&fastening)
         .chain(&flat.warning)
         .cloned()
         .collect();

@@ -12,6 +12,8 @@ use crate::error::{Error, Result};
 use crate::labels::LabelOptions;
 use crate::mesh::read::{parse_model, Format};
 use crate::mesh::{prepare, Mesh, PrepareOptions};
+use crate::scheme::SchemeOutput;
+use crate::units::fmt_num;
 
 /// A build whose median edge is shorter than this (mm) is refused: a laser's kerf is a
 /// tenth of it and the smallest legible label (1.5 mm) does not fit.
@@ -35,8 +37,8 @@ const IDS_LEFT_OUT: f64 = 0.01;
 /// A suggested budget aims the median edge this many times the smallest edge at which
 /// the scheme's panels on a regular mesh carry their labels: a simplified scan keeps a
 /// tenth of its edges below two thirds of the median, and those must still carry their
-/// ids (measured on spot at 3 ft, at the budget this gives: half-edge at 2,400 edges
-/// carries every panel id, quad-edge at 840 leaves 4 of 840 out).
+/// ids (on spot at 3 ft the budgets this gives carry every panel id, half-edge and
+/// quad-edge: tests/size_checks.rs).
 const SPREAD_MARGIN: f64 = 2.25;
 
 /// The fraction of the shortest edges a suggested `--size` lets fall below the
@@ -180,12 +182,29 @@ fn too_detailed(
 /// job's kind of faces, gives every panel its id and every connection its partner ids;
 /// found by building that mesh at trial sizes with the job's own options. `None` when
 /// no trial size up to 2 m fits them. Holes are not asked for: where flaps are too
-/// small for them the scheme's own note counts the connections without.
+/// small for them the fasteners check reports the connections without.
 pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let mut degrees: Vec<usize> = mesh.faces().map(|f| mesh.face_degree(f)).collect();
     degrees.sort_unstable();
     let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
-    let text: &[u8] = match typical {
+    smallest_edge(job, typical, |output| {
+        crate::flatten::unroll_all(&output.panels, LabelOptions::default())
+            .is_ok_and(|(_, left_out)| left_out.panel == 0 && left_out.partner == 0)
+    })
+}
+
+/// The smallest edge length (mm) at which the job's scheme, on a regular mesh of
+/// triangles (what a `--target-edges` budget makes), gives every connection a
+/// fastener hole; `None` when no trial size up to 2 m does.
+pub fn smallest_fastened_edge(job: &Job) -> Option<f64> {
+    smallest_edge(job, 3, |output| output.unfastened.is_empty())
+}
+
+/// The smallest edge length (mm), between 0.5 mm and 2 m to 2 %, at which the job's
+/// scheme built on a regular probe mesh of `degree`-sided faces makes an output that
+/// `fits` (searched on a log scale: larger faces fit what smaller ones do).
+fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool) -> Option<f64> {
+    let text: &[u8] = match degree {
         3 => include_bytes!("../models/icosahedron.obj"),
         4 => include_bytes!("../models/hexahedron.obj"),
         _ => include_bytes!("../models/dodecahedron.obj"),
@@ -193,32 +212,91 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let raw = parse_model(Path::new("probe.obj"), Format::Obj, text).ok()?;
     let probe = prepare(&raw, &PrepareOptions { weld: false }).ok()?.mesh;
     let edge = probe.edges().next().map(|e| probe.edge_length(e))?;
-    let labels_fit = |length: f64| -> bool {
+    let fits_at = |length: f64| -> bool {
         let mut scaled = probe.clone();
         scaled.scale(length / edge);
-        let Ok(output) = job.scheme.build(&scaled) else {
-            return false;
-        };
-        crate::flatten::unroll_all(&output.panels, LabelOptions::default())
-            .is_ok_and(|(_, left_out)| left_out.panel == 0 && left_out.partner == 0)
+        job.scheme.build(&scaled).is_ok_and(|output| fits(&output))
     };
-    // Bisection on a log scale between 0.5 mm and 2 m, to 2 %.
     let (mut lo, mut hi) = (0.5f64, 2000.0f64);
-    if !labels_fit(hi) {
+    if !fits_at(hi) {
         return None;
     }
-    if labels_fit(lo) {
+    if fits_at(lo) {
         return Some(lo);
     }
     while hi / lo > 1.02 {
         let mid = (lo * hi).sqrt();
-        if labels_fit(mid) {
+        if fits_at(mid) {
             hi = mid;
         } else {
             lo = mid;
         }
     }
     Some(hi)
+}
+
+/// A build where more than this fraction of the connections holds no fastener hole
+/// has faces too small for its fasteners: the warning gives the budget that fits
+/// them instead of naming connections.
+const MOST_UNFASTENED: f64 = 0.1;
+
+/// Connections a warning names before it counts the rest.
+const NAMED: usize = 5;
+
+/// The area of an equilateral triangle mesh per edge, in squared edge lengths
+/// (`√3/4` per face, 3/2 edges per face).
+const AREA_PER_EDGE: f64 = 0.288_675;
+
+/// Checks, after the scheme, that every connection holds a fastener hole when holes
+/// were asked for. A few without (sliver faces) are named with the fix; most without
+/// (a model too detailed for the fastener) gives one line with the `--target-edges`
+/// at which the faces hold one. [`refuse_unfastened`] makes either a refusal under
+/// `--strict`.
+pub fn check_fasteners(job: &Job, mesh: &Mesh, output: &SchemeOutput) -> Option<String> {
+    let bare = &output.unfastened;
+    if bare.is_empty() {
+        return None;
+    }
+    let panel = job.scheme.panel();
+    let hole = format!(
+        "{} mm fastener hole (with {} mm of material round it)",
+        fmt_num(panel.hole_diameter),
+        fmt_num(panel.hole_margin)
+    );
+    let (n, connections) = (bare.len(), output.connections);
+    let warning = if n as f64 > MOST_UNFASTENED * connections as f64 {
+        let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
+        let budget = smallest_fastened_edge(job)
+            .map(|edge| round_down_2(area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2))))
+            .filter(|&b| b >= 6.0 && b < mesh.edge_count() as f64);
+        let fix = match budget {
+            Some(b) => format!("--target-edges {b:.0} makes faces large enough for one"),
+            None => "simplify the model (--target-edges) or build it larger (--size)".into(),
+        };
+        format!(
+            "no {hole} fits at {n} of {connections} connections: the faces are too small for it at this size; {fix}"
+        )
+    } else {
+        let mut names: Vec<String> = bare.iter().take(NAMED).map(|c| c.to_string()).collect();
+        if n > NAMED {
+            names.push(format!("and {} more", n - NAMED));
+        }
+        format!(
+            "{n} of {connections} connections hold no {hole}, their faces too thin for it: {}; a smaller --hole-margin or --hole-diameter, or a --target-edges budget, gives them one",
+            names.join(", ")
+        )
+    };
+    Some(warning)
+}
+
+/// With `--strict`, the fasteners warning as a refusal (exit 1: the panels could not
+/// be assembled as asked). Made after the label check, whose refusal (a model too
+/// detailed for its size) names the more basic fix.
+pub fn refuse_unfastened(job: &Job, warning: Option<&String>) -> Result<()> {
+    match warning {
+        Some(w) if job.strict => Err(Error::Build(format!("{w} (refused by --strict)"))),
+        _ => Ok(()),
+    }
 }
 
 /// How large the model would be in other units, for a forgotten `--size`.

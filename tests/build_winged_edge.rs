@@ -119,6 +119,40 @@ fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
     counts
 }
 
+/// Every corner holds fastener holes at the defaults where the faces have room: the
+/// tori at 1 ft (the inner quads of torus-8x6 are thin) and the thesis' bunny at 4 ft
+/// with 625 edges. Where a corner's shared regions are too small the face's band
+/// widens; the holes still meet in 3D.
+#[test]
+fn every_corner_holds_fasteners_at_the_defaults() {
+    let tmp = TempDir::new().unwrap();
+    for name in ["torus-6x4", "torus-8x6"] {
+        let mut o = options("winged-edge", "1ft", 2, tmp.path());
+        o.holes = None;
+        let job = resolve(o, &model(name));
+        let counts = holes_per_connection(&job, name);
+        let p = pipeline(&job);
+        let corners: usize = p.mesh.faces().map(|f| p.mesh.face_degree(f)).sum();
+        assert_eq!(counts.len(), corners, "{name}: every corner has holes");
+        assert!(p.output.unfastened.is_empty(), "{name}");
+    }
+    let Some(shared) = common::build::shared_models("every_corner_holds_fasteners_at_the_defaults")
+    else {
+        return;
+    };
+    let out = tmp.path().join("bunny");
+    let m = build(
+        "winged-edge",
+        &shared.join("stanford-bunny.obj"),
+        "4ft",
+        &out,
+        &["--target-edges", "625", "--nester", "shelf"],
+    );
+    let by_holes = &m["counts"]["connections_by_holes"];
+    assert!(by_holes.get("0").is_none(), "bunny: {by_holes}");
+    assert_eq!(count(&m, "counts.connections"), 1227);
+}
+
 #[test]
 fn holes_of_a_connection_meet_in_3d() {
     let tmp = TempDir::new().unwrap();

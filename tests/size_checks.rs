@@ -182,8 +182,8 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
         );
         // The suggested budget, run, carries every panel's id and nearly every
         // partner id, with no warning: the budget is worked out for even faces, and
-        // the smaller faces a simplified mesh keeps lose a partner id, so at most 5 %
-        // of them may be left out.
+        // the smaller faces a simplified mesh keeps lose a partner id, so at most a
+        // tenth of them may be left out.
         let mut suggested = args.to_vec();
         suggested.extend(["--target-edges", &budget, "--strict", "--quiet"]);
         let run = build(&spot, &out, &suggested);
@@ -203,7 +203,7 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
         let partners = 2 * count(&manifest, "counts.connections");
         let partners_out = count(&manifest, "counts.partner_ids_left_out");
         assert!(
-            partners_out * 20 <= partners,
+            partners_out * 10 <= partners,
             "{scheme} at {budget} edges: {partners_out} of {partners} partner ids left out"
         );
         assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");

@@ -105,10 +105,13 @@ pub struct FaceFlaps {
     holes: Vec<(DVec3, u32, u32)>,
     /// Connections (face corners) with fewer holes than wanted.
     pub reduced: usize,
-    /// Connections with no hole at all although holes were wanted.
-    pub bare: usize,
+    /// Connections with no hole at all although holes were wanted: the half-edge
+    /// leaving each one's corner.
+    pub bare: Vec<HalfedgeId>,
     /// Connections whose flaps grew deeper than `--flap-scale` to hold their holes.
     pub grown: usize,
+    /// The band is wider than `--face-scale`, to hold holes at corners that could not.
+    pub widened: bool,
 }
 
 impl FaceFlaps {
@@ -126,8 +129,9 @@ impl FaceFlaps {
             rest_ends: Vec::with_capacity(n),
             holes: Vec::new(),
             reduced: 0,
-            bare: 0,
+            bare: Vec::new(),
             grown: 0,
+            widened: false,
         }
     }
 
@@ -241,6 +245,44 @@ pub fn band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> (Vec<DVec3>, Vec<D
     (band, flat, frame)
 }
 
+/// The widest face band a face gets where a corner cannot hold a hole otherwise.
+pub const MAX_FACE_SCALE: f64 = 0.9;
+
+/// Steps from `--face-scale` to [`MAX_FACE_SCALE`] tried for such a face.
+const BAND_STEPS: u32 = 4;
+
+/// A face's flaps (`flaps_in_band` at the options' face scale); where a corner cannot
+/// hold its holes even so, the face's band widened (its corners nearer the face's
+/// own), step by step, kept where it leaves fewer corners bare, or as many bare and
+/// fewer short of holes. The bends stay developable:
+/// each band edge stays parallel to its mesh edge whatever the scale.
+pub fn widened_where_bare(
+    options: &EdgeOptions,
+    flaps_in_band: impl Fn(&EdgeOptions) -> FaceFlaps,
+) -> FaceFlaps {
+    let first = flaps_in_band(options);
+    let scale = options.panel.face_scale;
+    let shortfall = |f: &FaceFlaps| (f.bare.len(), f.reduced);
+    if shortfall(&first) == (0, 0) || scale >= MAX_FACE_SCALE {
+        return first;
+    }
+    let mut best = first;
+    for i in 1..=BAND_STEPS {
+        let mut wider = options.clone();
+        wider.panel.face_scale =
+            scale + (MAX_FACE_SCALE - scale) * f64::from(i) / f64::from(BAND_STEPS);
+        let mut tried = flaps_in_band(&wider);
+        if shortfall(&tried) < shortfall(&best) {
+            tried.widened = true;
+            best = tried;
+        }
+        if shortfall(&best) == (0, 0) {
+            break;
+        }
+    }
+    best
+}
+
 /// The half-edges of a face in loop order (corner k is the origin of the k-th).
 pub fn corner_half_edges(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
     mesh.face_half_edges(f).collect()
@@ -308,8 +350,22 @@ pub fn edge_scheme(
         panels,
         connections,
         notes: edge_scheme_notes(mesh, &faces, connections, options),
+        unfastened: unfastened(mesh, &faces),
         ..super::SchemeOutput::default()
     }
+}
+
+/// The connections without a hole, face by face: the edge panels before and after
+/// each bare corner, at its vertex.
+pub fn unfastened(mesh: &Mesh, faces: &[FaceFlaps]) -> Vec<super::ConnectionName> {
+    faces
+        .iter()
+        .flat_map(|f| &f.bare)
+        .map(|&h| super::ConnectionName {
+            panels: [panel_id(mesh.prev(h).edge()), panel_id(h.edge())],
+            at: Name::Vertex(mesh.origin(h).0),
+        })
+        .collect()
 }
 
 /// Report lines shared by the edge schemes: holes that did not fit, boundary panels.
@@ -319,8 +375,9 @@ pub fn edge_scheme_notes(
     connections: usize,
     options: &EdgeOptions,
 ) -> Vec<String> {
-    let reduced: usize = faces.iter().map(|f| f.reduced).sum();
-    let bare: usize = faces.iter().map(|f| f.bare).sum();
+    let bare: usize = faces.iter().map(|f| f.bare.len()).sum();
+    // Connections without any hole are reported by the build (the fasteners check).
+    let reduced = faces.iter().map(|f| f.reduced).sum::<usize>() - bare;
     let grown: usize = faces.iter().map(|f| f.grown).sum();
     let panel = &options.panel;
     let mut notes = Vec::new();
@@ -330,9 +387,17 @@ pub fn edge_scheme_notes(
             options.flap_scale
         ));
     }
+    let widened = faces.iter().filter(|f| f.widened).count();
+    if widened > 0 {
+        notes.push(format!(
+            "{widened} of {} faces have a wider band than --face-scale {} to hold their fastener holes",
+            faces.len(),
+            panel.face_scale
+        ));
+    }
     if reduced > 0 {
         notes.push(format!(
-            "{reduced} of {connections} connections have fewer than {} fastener holes ({bare} have none): their flap overlaps cannot hold more {} mm holes with {} mm of material around each; a larger --size, a smaller --hole-diameter or --hole-margin, or fewer panels (--target-edges) helps",
+            "{reduced} of {connections} connections have fewer than {} fastener holes (but at least one): their flap overlaps cannot hold more {} mm holes with {} mm of material around each; a larger --size, a smaller --hole-diameter or --hole-margin, or fewer panels (--target-edges) helps",
             panel.holes,
             crate::units::fmt_num(panel.hole_diameter),
             crate::units::fmt_num(panel.hole_margin)

@@ -33,7 +33,7 @@ struct Tab {
     holes: Vec<DVec3>,
     /// The tab is lower than wanted.
     shortened: bool,
-    /// Holes were wanted but do not fit.
+    /// Fewer holes than wanted fit (perhaps none).
     holes_skipped: bool,
 }
 
@@ -226,13 +226,32 @@ pub fn panels(mesh: &Mesh, options: &HalfEdgeOptions) -> SchemeOutput {
             "{shortened} tabs were shortened to stay inside their neighbour face"
         ));
     }
-    let skipped = tabs.tabs.iter().filter(|t| t.holes_skipped).count();
-    if skipped > 0 {
+    // Connections without any hole are reported by the build (the fasteners check).
+    let fewer = tabs
+        .tabs
+        .iter()
+        .filter(|t| t.holes_skipped && !t.holes.is_empty())
+        .count();
+    if fewer > 0 {
         notes.push(format!(
-            "{skipped} connections have no fastener holes: the tab is too small for a {} mm hole",
-            options.panel.hole_diameter
+            "{fewer} of {connections} connections have fewer than {} fastener holes (but at least one): their tab cannot hold more {} mm holes with {} mm of material around each; a larger --tab-height or --size, or a smaller --hole-diameter or --hole-margin, helps",
+            options.panel.holes,
+            crate::units::fmt_num(options.panel.hole_diameter),
+            crate::units::fmt_num(options.panel.hole_margin)
         ));
     }
+    let unfastened = tabs
+        .tabs
+        .iter()
+        .filter(|t| options.panel.holes > 0 && t.holes.is_empty())
+        .filter_map(|t| {
+            let neighbour = mesh.face(t.owner.twin())?;
+            Some(super::ConnectionName {
+                panels: [Name::Face(mesh.face(t.owner)?.0), Name::Face(neighbour.0)],
+                at: Name::Edge(t.owner.edge().0),
+            })
+        })
+        .collect();
 
     let panels = Panels::build(mesh.face_count(), |f| {
         let f = FaceId(f as u32);
@@ -248,6 +267,7 @@ pub fn panels(mesh: &Mesh, options: &HalfEdgeOptions) -> SchemeOutput {
         panels,
         connections,
         notes,
+        unfastened,
         ..SchemeOutput::default()
     }
 }
@@ -456,7 +476,8 @@ fn make_tab(mesh: &Mesh, owner: HalfedgeId, options: &HalfEdgeOptions) -> Option
 }
 
 /// Hole centres along the middle of the tab's overlap with the neighbour band, each
-/// at least one radius of material away from the tab's and the band's outline.
+/// with the hole margin of material to the tab's and the band's outline: as many as
+/// asked, or as many as fit; and whether fewer than asked fit.
 fn place_holes(
     tab: &[DVec2],
     gap: f64,
@@ -472,35 +493,38 @@ fn place_holes(
     let r = 0.5 * options.panel.hole_diameter;
     // The hole's radius and the margin of material to the tab's and the face's edges.
     let clearance = r + options.panel.hole_margin;
-    let v = 0.5 * (gap + top_height);
-    // The tab's extent at height v (it is convex: two crossings).
-    let mut xs = Vec::new();
-    for i in 0..tab.len() {
-        let (p, q) = (tab[i], tab[(i + 1) % tab.len()]);
-        if (p.y - v) * (q.y - v) <= 0.0 && p.y != q.y {
-            xs.push(p.x + (v - p.y) / (q.y - p.y) * (q.x - p.x));
+    let along = |count: u32| -> Option<Vec<DVec2>> {
+        let v = 0.5 * (gap + top_height);
+        // The tab's extent at height v (it is convex: two crossings).
+        let mut xs = Vec::new();
+        for i in 0..tab.len() {
+            let (p, q) = (tab[i], tab[(i + 1) % tab.len()]);
+            if (p.y - v) * (q.y - v) <= 0.0 && p.y != q.y {
+                xs.push(p.x + (v - p.y) / (q.y - p.y) * (q.x - p.x));
+            }
         }
-    }
-    let (Some(u0), Some(u1)) = (
-        xs.iter().copied().reduce(f64::min),
-        xs.iter().copied().reduce(f64::max),
-    ) else {
-        return (Vec::new(), true);
+        let (Some(u0), Some(u1)) = (
+            xs.iter().copied().reduce(f64::min),
+            xs.iter().copied().reduce(f64::max),
+        ) else {
+            return None;
+        };
+        let band: Vec<DVec2> = neighbour_band.iter().map(|&p| to2(p)).collect();
+        let centres: Vec<DVec2> = (1..=count)
+            .map(|k| DVec2::new(u0 + (u1 - u0) * k as f64 / (count + 1) as f64, v))
+            .collect();
+        let fits = centres.iter().all(|&c| {
+            distance_to_border(tab, c) >= clearance
+                && crate::plane::contains(&band, c)
+                && distance_to_border(&band, c) >= clearance
+        }) && centres
+            .windows(2)
+            .all(|w| w[0].distance(w[1]) >= 2.0 * r + options.panel.hole_diameter);
+        fits.then_some(centres)
     };
-    let band: Vec<DVec2> = neighbour_band.iter().map(|&p| to2(p)).collect();
-    let centres: Vec<DVec2> = (1..=count)
-        .map(|k| DVec2::new(u0 + (u1 - u0) * k as f64 / (count + 1) as f64, v))
-        .collect();
-    let fits = centres.iter().all(|&c| {
-        distance_to_border(tab, c) >= clearance
-            && crate::plane::contains(&band, c)
-            && distance_to_border(&band, c) >= clearance
-    }) && centres
-        .windows(2)
-        .all(|w| w[0].distance(w[1]) >= 2.0 * r + options.panel.hole_diameter);
-    if fits {
-        (centres, false)
-    } else {
-        (Vec::new(), true)
-    }
+    // The wanted count, or as many as fit.
+    (1..=count)
+        .rev()
+        .find_map(|n| along(n).map(|centres| (centres, n < count)))
+        .unwrap_or((Vec::new(), true))
 }

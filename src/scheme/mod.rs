@@ -21,7 +21,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::mesh::{FaceId, Mesh};
-use crate::panel::Panels;
+use crate::panel::{Name, Panels};
 use crate::record::{round4, Params};
 
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
@@ -375,6 +375,24 @@ pub struct SchemeOutput {
     pub report: Vec<String>,
     /// Sections the manifest gets about them, after its warnings.
     pub manifest: Params,
+    /// Connections that hold no fastener hole although holes were asked for (no room
+    /// for one), in a deterministic order.
+    pub unfastened: Vec<ConnectionName>,
+}
+
+/// A connection as a builder finds it: the two panels it joins and where they meet.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ConnectionName {
+    /// The panels' ids.
+    pub panels: [Name; 2],
+    /// The mesh element they meet at (a vertex for the edge schemes).
+    pub at: Name,
+}
+
+impl std::fmt::Display for ConnectionName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{} at {}", self.panels[0], self.panels[1], self.at)
+    }
 }
 
 /// Errors a scheme reports, each message naming its fix (the scheme's file writes

@@ -20,8 +20,8 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
-    EDGE_DEFAULTS,
+    band, corner_half_edges, edge_scheme, place_pins, widened_where_bare, BandArgs, EdgeOptions,
+    FaceFlaps, EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -108,6 +108,11 @@ struct Corner {
 /// fit by [`MAX_FLAP_SCALE`]), so every connection gets its fasteners where the face has
 /// room for them.
 fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
+    widened_where_bare(options, |o| flaps_in_band(mesh, f, o))
+}
+
+/// [`face_flaps`] in the band of `options`' face scale.
+fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
@@ -276,9 +281,11 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
             })
             .collect();
         parts.reduced += usize::from((pins.len() as u32) < panel.holes);
-        parts.bare += usize::from(panel.holes > 0 && pins.is_empty());
         // The connection at corner k is named by the half-edge leaving it; both flaps
         // meeting there carry its holes.
+        if panel.holes > 0 && pins.is_empty() {
+            parts.bare.push(half_edges[k]);
+        }
         let connection = half_edges[k].0;
         for pin in pins {
             parts.add_hole([prev, k], frame.to3(pin), connection);

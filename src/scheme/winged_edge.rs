@@ -16,8 +16,8 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
-    EDGE_DEFAULTS,
+    band, corner_half_edges, edge_scheme, place_pins, widened_where_bare, BandArgs, EdgeOptions,
+    FaceFlaps, EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -107,8 +107,10 @@ impl Configured for WingedEdgeOptions {
 /// Builds the winged edge panels of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
     let shift = options.shift;
+    // Where a corner holds no hole, the face's band widens as in quad-edge (the
+    // wings do not grow).
     edge_scheme(mesh, &options.edge, |mesh, f, edge| {
-        face_flaps(mesh, f, edge, shift)
+        widened_where_bare(edge, |o| face_flaps(mesh, f, o, shift))
     })
 }
 
@@ -183,11 +185,12 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions, shift: i32) -> Face
         }
     }
     parts.reduced = short_at_corner.iter().filter(|&&s| s).count();
-    parts.bare = if options.panel.holes > 0 {
-        placed_at_corner.iter().filter(|&&c| c == 0).count()
-    } else {
-        0
-    };
+    if options.panel.holes > 0 {
+        parts.bare = (0..n)
+            .filter(|&k| placed_at_corner[k] == 0)
+            .map(|k| half_edges[k])
+            .collect();
+    }
     parts.shrink_to_fit();
     parts
 }

@@ -957,6 +957,7 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
         notes,
         report: cycle_report(&cycles),
         manifest: cycle_manifest(&cycles),
+        ..SchemeOutput::default()
     })
 }
 
