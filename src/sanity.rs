@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::labels::LabelOptions;
 use crate::mesh::read::{parse_model, Format};
 use crate::mesh::{prepare, Mesh, PrepareOptions};
-use crate::scheme::SchemeOutput;
+use crate::scheme::{SchemeOutput, MOST_UNFASTENED};
 use crate::units::fmt_num;
 
 /// A build whose median edge is shorter than this (mm) is refused: a laser's kerf is a
@@ -234,11 +234,6 @@ fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool)
     }
     Some(hi)
 }
-
-/// A build where more than this fraction of the connections holds no fastener hole
-/// has faces too small for its fasteners: the warning gives the budget that fits
-/// them instead of naming connections.
-const MOST_UNFASTENED: f64 = 0.1;
 
 /// Connections a warning names before it counts the rest.
 const NAMED: usize = 5;

@@ -251,18 +251,19 @@ pub const MAX_FACE_SCALE: f64 = 0.9;
 /// Steps from `--face-scale` to [`MAX_FACE_SCALE`] tried for such a face.
 const BAND_STEPS: u32 = 4;
 
-/// A face's flaps (`flaps_in_band` at the options' face scale); where a corner cannot
-/// hold its holes even so, the face's band widened (its corners nearer the face's
-/// own), step by step, kept where it leaves fewer corners bare, or as many bare and
-/// fewer short of holes. The bends stay developable:
-/// each band edge stays parallel to its mesh edge whatever the scale.
+/// A face's flaps `first` (at the options' face scale); where a corner cannot hold a
+/// hole (with `widen_short`, all its holes) even so, the face's band widened (its
+/// corners nearer the face's own), step by step with `flaps_in_band`, kept where it
+/// leaves fewer corners bare, or as many bare and fewer short of holes. The bends stay
+/// developable: each band edge stays parallel to its mesh edge whatever the scale.
 pub fn widened_where_bare(
     options: &EdgeOptions,
+    widen_short: bool,
+    first: FaceFlaps,
     flaps_in_band: impl Fn(&EdgeOptions) -> FaceFlaps,
 ) -> FaceFlaps {
-    let first = flaps_in_band(options);
     let scale = options.panel.face_scale;
-    let shortfall = |f: &FaceFlaps| (f.bare.len(), f.reduced);
+    let shortfall = |f: &FaceFlaps| (f.bare.len(), if widen_short { f.reduced } else { 0 });
     if shortfall(&first) == (0, 0) || scale >= MAX_FACE_SCALE {
         return first;
     }
@@ -333,17 +334,45 @@ pub fn place_pins(
 }
 
 /// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
-/// face order), then the panels, the connection count (one per face corner) and the
-/// report lines.
+/// face order), widened where corners need it (see [`widened_where_bare`]; where a
+/// corner holds fewer holes than wanted too, with `widen_short`), then the panels, the
+/// connection count (one per face corner) and the report lines.
 pub fn edge_scheme(
     mesh: &Mesh,
     options: &EdgeOptions,
+    widen_short: bool,
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> super::SchemeOutput {
-    let faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
+    let mut faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
         .into_par_iter()
         .map(|f| face_flaps(mesh, FaceId(f), options))
         .collect();
+    let needs = |f: &FaceFlaps| !f.bare.is_empty() || (widen_short && f.reduced > 0);
+    let widened: Vec<(usize, FaceFlaps)> = (0..faces.len())
+        .into_par_iter()
+        .filter(|&k| needs(&faces[k]))
+        .map(|k| {
+            let f = FaceId(k as u32);
+            let flaps = widened_where_bare(options, widen_short, faces[k].clone(), |o| {
+                face_flaps(mesh, f, o)
+            });
+            (k, flaps)
+        })
+        .collect();
+    // A model still too detailed for its fasteners with widened bands (the build warns
+    // with a budget) keeps its own bands: wider ones would cost sheets for a panel set
+    // that cannot be assembled as asked anyway.
+    let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
+    let bare_after: usize = faces.iter().map(|f| f.bare.len()).sum::<usize>()
+        - widened
+            .iter()
+            .map(|(k, w)| faces[*k].bare.len() - w.bare.len())
+            .sum::<usize>();
+    if (bare_after as f64) <= super::MOST_UNFASTENED * corners as f64 {
+        for (k, flaps) in widened {
+            faces[k] = flaps;
+        }
+    }
     let panels = edge_panels(mesh, &faces, options);
     let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
     super::SchemeOutput {

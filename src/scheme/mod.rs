@@ -380,6 +380,11 @@ pub struct SchemeOutput {
     pub unfastened: Vec<ConnectionName>,
 }
 
+/// A build where more than this fraction of the connections holds no fastener hole
+/// has faces too small for its fasteners: the build warns with the budget that fits
+/// them, and the edge schemes do not widen face bands for it.
+pub const MOST_UNFASTENED: f64 = 0.1;
+
 /// A connection as a builder finds it: the two panels it joins and where they meet.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ConnectionName {

@@ -20,8 +20,8 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, widened_where_bare, BandArgs, EdgeOptions,
-    FaceFlaps, EDGE_DEFAULTS,
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -82,7 +82,7 @@ impl Configured for EdgeOptions {
 
 /// Builds the edge panels of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
-    edge_scheme(mesh, options, face_flaps)
+    edge_scheme(mesh, options, true, flaps_in_band)
 }
 
 /// The deepest a flap grows, in units of its band edge's distance from the face centre
@@ -107,11 +107,8 @@ struct Corner {
 /// two flaps meeting there grow (to the smallest depth that holds the most holes that
 /// fit by [`MAX_FLAP_SCALE`]), so every connection gets its fasteners where the face has
 /// room for them.
-fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
-    widened_where_bare(options, |o| flaps_in_band(mesh, f, o))
-}
-
-/// [`face_flaps`] in the band of `options`' face scale.
+/// Band, flaps and corner overlaps of one face in the band of `options`' face scale
+/// (the scheme widens it where corners need room: [`edge_scheme`]).
 fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();

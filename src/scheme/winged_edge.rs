@@ -16,8 +16,8 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, widened_where_bare, BandArgs, EdgeOptions,
-    FaceFlaps, EDGE_DEFAULTS,
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -108,9 +108,10 @@ impl Configured for WingedEdgeOptions {
 pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
     let shift = options.shift;
     // Where a corner holds no hole, the face's band widens as in quad-edge (the
-    // wings do not grow).
-    edge_scheme(mesh, &options.edge, |mesh, f, edge| {
-        widened_where_bare(edge, |o| face_flaps(mesh, f, o, shift))
+    // wings do not grow); not for fewer holes than wanted, which the two shared
+    // regions of a corner usually are, and wider bands there cost sheets.
+    edge_scheme(mesh, &options.edge, false, |mesh, f, edge| {
+        face_flaps(mesh, f, edge, shift)
     })
 }
 
