@@ -68,14 +68,15 @@ impl std::error::Error for InputError {}
 /// whole chain.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
-    /// Options or configuration the tool cannot use (exit code 2).
+    /// Options or configuration the tool cannot use, or that do not fit the model (a
+    /// panel larger than the sheet) (exit code 2).
     #[error("{0}")]
     Usage(String),
     /// An input model that cannot be used (exit code 3).
     #[error(transparent)]
     Input(#[from] InputError),
-    /// The model cannot be built as asked: a panel larger than the sheet, one that
-    /// overlaps itself (exit code 1).
+    /// The model cannot be built as asked: a panel that overlaps itself, connections
+    /// without a fastener under `--strict` (exit code 1).
     #[error("{0}")]
     Build(String),
     /// A file or folder that cannot be read or written (exit code 1).
@@ -153,7 +154,10 @@ mod tests {
         };
         assert!(io.to_string().starts_with("cannot create /out: "), "{io}");
         assert_eq!(io.exit_code(), 1);
-        assert_eq!(Error::Build("panel E1 …".into()).exit_code(), 1);
+        assert_eq!(
+            Error::Build("panel E1 overlaps itself".into()).exit_code(),
+            1
+        );
         assert_eq!(Error::Usage("--size".into()).exit_code(), 2);
         let input = InputError::new(Path::new("m.obj"), Location::Line(3), "bad", "fix");
         assert_eq!(Error::from(input).exit_code(), 3);

@@ -314,8 +314,9 @@ pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
         spacing: job.spacing,
     };
     let outlines: Vec<Vec<DVec2>> = flat.iter().map(|p| p.outer()).collect();
+    // The options do not fit the model: a usage error (exit 2), like any other.
     let too_large = |e: crate::nest::TooLarge| {
-        Error::Build(format!(
+        Error::Usage(format!(
             "panel {} is {:.1} x {:.1} mm and does not fit on the {} sheet (usable {:.1} x {:.1} mm inside the margin); use a larger --sheet or a smaller --size",
             flat.get(e.part).id(), e.width, e.height, job.sheet.name, e.usable_width, e.usable_height
         ))

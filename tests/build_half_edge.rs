@@ -677,7 +677,7 @@ fn output_folder_is_replaced_atomically() {
     let run = fail(&out);
     assert_eq!(
         run.code,
-        Some(1),
+        Some(2),
         "a panel larger than the sheet: {}",
         run.stderr
     );
@@ -727,7 +727,7 @@ fn output_folder_is_replaced_atomically() {
 
     let fresh = tmp.path().join("fresh");
     let run = fail(&fresh);
-    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
     assert!(
         !fresh.exists(),
         "a failed job into a new folder leaves no folder"

@@ -209,3 +209,26 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
         assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");
     }
 }
+
+/// A panel larger than the usable sheet is a mistake in the options (exit 2), named
+/// with its size and the fix, and nothing is written.
+#[test]
+fn a_panel_larger_than_the_sheet_is_a_usage_error() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let run = build(
+        &model("tetrahedron"),
+        &out,
+        &["--size", "1m", "--sheet", "A5"],
+    );
+    assert_refused(
+        "1 m tetrahedron on A5",
+        &run,
+        &out,
+        &[
+            "panel F",
+            " mm and does not fit on the A5 sheet",
+            "use a larger --sheet or a smaller --size",
+        ],
+    );
+}
