@@ -5,6 +5,7 @@
 use glam::DVec2;
 
 use crate::font::text_width;
+pub use crate::panel::label_box;
 use crate::panel::{
     box_area, label_extent, FacetFrame, FlatLabel, FlatPanel, LabelKind, LoopsRef, PanelRef,
     FRAME_PAD, TIGHT_FRAME_PAD,
@@ -36,18 +37,6 @@ const HEIGHT_PASSES: usize = 3;
 const SLIDES: [f64; 9] = [0.0, -0.25, 0.25, -0.5, 0.5, -0.75, 0.75, -1.0, 1.0];
 const COARSE_SLIDES: [f64; 5] = [0.0, -0.5, 0.5, -1.0, 1.0];
 
-/// The text box of a label: corners counter-clockwise (baseline first).
-pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [DVec2; 4] {
-    let along = 0.5 * width * direction;
-    let up = 0.5 * height * direction.perp();
-    [
-        center - along - up,
-        center + along - up,
-        center + along + up,
-        center - along + up,
-    ]
-}
-
 /// Free space kept between two labels, in cap heights of the taller one: about a word
 /// space, so neighbouring ids never read as one ("E587 F371", not "E587F371").
 pub const LABEL_GAP: f64 = 0.4;
@@ -77,7 +66,7 @@ pub fn fit_labels(
             break;
         }
         let next = fit_pass(panel, source, frames, options, smallest);
-        let keeps_all = [LabelKind::Panel, LabelKind::Partner, LabelKind::Mark]
+        let keeps_all = LabelKind::ALL
             .into_iter()
             .all(|kind| next.dropped.of(kind) <= chosen.dropped.of(kind));
         if !keeps_all {
@@ -143,12 +132,12 @@ fn fit_pass(
         };
         // A panel id is framed; on a panel too small for the frame, tightly framed,
         // and only on one too small for that, unframed rather than missing.
-        let frames: &[f64] = if is_panel {
+        let frame_pads: &[f64] = if is_panel {
             &[FRAME_PAD, TIGHT_FRAME_PAD, 0.0]
         } else {
             &[0.0]
         };
-        let fitted = frames.iter().find_map(|&frame| {
+        let fitted = frame_pads.iter().find_map(|&frame| {
             let text = Text { frame, ..text };
             attempts.iter().find_map(|attempt| {
                 fit_one(panel, facets, attempt, text, &placed, options).map(|fit| (fit, frame))

@@ -104,6 +104,11 @@ pub enum LabelKind {
     Mark,
 }
 
+impl LabelKind {
+    /// Every kind, in fitting order.
+    pub const ALL: [LabelKind; 3] = [LabelKind::Panel, LabelKind::Partner, LabelKind::Mark];
+}
+
 /// An engraved text: anchored at the centre of its text box, or, for `on_edge` labels,
 /// at a point on the facet's edge with the box pushed inside along the left normal of
 /// `direction` (so it sits just inside that edge whatever its final height).
@@ -1050,6 +1055,18 @@ pub(crate) fn drop_unfittable(
         fits
     });
     dropped
+}
+
+/// The text box of a label: corners counter-clockwise (baseline first).
+pub fn label_box(center: DVec2, direction: DVec2, width: f64, height: f64) -> [DVec2; 4] {
+    let along = 0.5 * width * direction;
+    let up = 0.5 * height * direction.perp();
+    [
+        center - along - up,
+        center + along - up,
+        center + along + up,
+        center - along + up,
+    ]
 }
 
 /// How far the frame engraved around a panel's own id stands off its text, in cap

@@ -26,9 +26,10 @@ use serde_json::Value;
 use tempfile::TempDir;
 
 use common::build::{
-    build, check_output, check_sheets, count, distance_to_border, frames_of, golden_build, inside,
-    inspect_json, model, num, pipeline, read_simple_obj, resolve, shared_models, DxfCheck,
-    Pipeline, Run,
+    build, check_output, check_sheets, connections_without_holes, count, distance_to_border,
+    frames_of, golden_build, inside, inspect_json, model, num, number_after, pipeline,
+    point_segment, read_simple_obj, resolve, segment_distance, shared_models, DxfCheck, Pipeline,
+    Run,
 };
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
@@ -173,25 +174,6 @@ fn signed_area(poly: &[DVec2]) -> f64 {
         .map(|i| poly[i].perp_dot(poly[(i + 1) % n]))
         .sum::<f64>()
         * 0.5
-}
-
-fn point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-    p.distance(a + t * (b - a))
-}
-
-/// Distance between two segments (0 when they cross).
-fn segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
-    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-    let (o1, o2) = (orient(a, b, c), orient(a, b, d));
-    let (o3, o4) = (orient(c, d, a), orient(c, d, b));
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return 0.0;
-    }
-    point_segment(a, c, d)
-        .min(point_segment(b, c, d))
-        .min(point_segment(c, a, b))
-        .min(point_segment(d, a, b))
 }
 
 /// Why a closed polygon is not simple (edges that are not neighbours closer than `eps`,
@@ -1420,8 +1402,8 @@ fn face_inradius(mesh: &Mesh, f: FaceId) -> f64 {
 /// hole's radius plus its margin fits in the face (the hole must fit in the corner's
 /// overlap of two flaps, with its margin to every side of both).
 #[test]
-fn only_sliver_faces_leave_a_connection_without_a_fastener() {
-    let Some(shared) = shared_models("only_sliver_faces_leave_a_connection_without_a_fastener")
+fn only_small_faces_leave_a_connection_without_a_fastener() {
+    let Some(shared) = shared_models("only_small_faces_leave_a_connection_without_a_fastener")
     else {
         return;
     };
@@ -1431,9 +1413,7 @@ fn only_sliver_faces_leave_a_connection_without_a_fastener() {
         let out = tmp.path().join(name);
         let args = ["--target-edges", "1000", "--nester", "shelf"];
         let (m, run) = build_run(&path, "4ft", &out, &args);
-        let bare = m["counts"]["connections_by_holes"]["0"]
-            .as_u64()
-            .unwrap_or(0) as usize;
+        let bare = connections_without_holes(&m);
         let connections = count(&m, "counts.connections");
         assert!(
             bare * 100 <= connections,
@@ -1442,7 +1422,8 @@ fn only_sliver_faces_leave_a_connection_without_a_fastener() {
         let mut options = quad_options("4ft", 2, &out);
         options.holes = None;
         options.model.target_edges = Some(1000);
-        let p = pipeline(&resolve(options, &path));
+        let job = resolve(options, &path);
+        let p = pipeline(&job);
         assert_eq!(p.output.unfastened.len(), bare, "{name}: the scheme's list");
         if bare > 0 {
             let line = run
@@ -1457,8 +1438,8 @@ fn only_sliver_faces_leave_a_connection_without_a_fastener() {
             assert!(line.contains(&p.output.unfastened[0].to_string()), "{line}");
             assert!(line.contains("--hole-margin"), "{line}");
         }
-        let r = 0.5 * 3.175;
-        let margin = r;
+        let r = 0.5 * job.scheme.panel().hole_diameter;
+        let margin = job.scheme.panel().hole_margin;
         for c in &p.output.unfastened {
             let edges = c.panels.map(|n| match n {
                 unfold::panel::Name::Edge(e) => EdgeId(e),
@@ -1493,10 +1474,10 @@ fn only_sliver_faces_leave_a_connection_without_a_fastener() {
 fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
     let tmp = TempDir::new().unwrap();
     let out = tmp.path().join("out");
-    let spot = model("torus-8x6");
+    let torus = model("torus-8x6");
     // At 1 ft the inner quads of the torus hold their labels but no 3/8 in hole.
     let big = ["--hole-diameter", "0.375in", "--nester", "shelf"];
-    let (m, run) = build_run(&spot, "1ft", &out, &big);
+    let (m, run) = build_run(&torus, "1ft", &out, &big);
     let lines: Vec<&str> = run
         .stderr
         .lines()
@@ -1507,13 +1488,7 @@ fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
         .find(|l| l.contains(" fits at "))
         .unwrap_or_else(|| panic!("no one-line warning:\n{}", run.stderr));
     assert!(!warning.contains(" at V"), "names connections: {warning}");
-    let at = warning.find("--target-edges ").expect("a budget") + "--target-edges ".len();
-    let budget: usize = warning[at..]
-        .chars()
-        .take_while(char::is_ascii_digit)
-        .collect::<String>()
-        .parse()
-        .unwrap();
+    let budget = number_after(warning, "--target-edges ").expect("a budget");
     assert!(
         m["warnings"].to_string().contains(" fits at "),
         "{}",
@@ -1522,7 +1497,7 @@ fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
 
     let strict = tmp.path().join("strict");
     let run = common::build::unfold([
-        spot.to_str().unwrap(),
+        torus.to_str().unwrap(),
         "--scheme",
         "quad-edge",
         "--size",
@@ -1560,11 +1535,9 @@ fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
         !run.stderr.contains(" connections hold no "),
         "one line, not names"
     );
-    let at = warning.find("--target-edges ").expect("a budget") + "--target-edges ".len();
-    let budget: String = warning[at..]
-        .chars()
-        .take_while(char::is_ascii_digit)
-        .collect();
+    let budget = number_after(warning, "--target-edges ")
+        .expect("a budget")
+        .to_string();
     let fitted = tmp.path().join("fitted");
     let (m, _) = build_run(
         &horse,
@@ -1572,9 +1545,7 @@ fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
         &fitted,
         &["--target-edges", &budget, "--nester", "shelf"],
     );
-    let bare = m["counts"]["connections_by_holes"]["0"]
-        .as_u64()
-        .unwrap_or(0) as usize;
+    let bare = connections_without_holes(&m);
     let connections = count(&m, "counts.connections");
     eprintln!("horse_quad at the suggested {budget} edges: {bare} of {connections} without a hole");
     assert!(

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::build::{options, resolve, shared_models};
+use common::build::{inside, options, resolve, segment_distance, shared_models};
 use glam::DVec2;
 use tempfile::TempDir;
 use unfold::font::text_strokes;
@@ -47,38 +47,15 @@ fn glyph_box(label: &FlatLabel) -> [DVec2; 4] {
     ]
 }
 
-fn point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-300)).clamp(0.0, 1.0);
-    p.distance(a + t * ab)
-}
-
-fn crosses(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
-    let side = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
-    side(a, b, c) * side(a, b, d) < 0.0 && side(c, d, a) * side(c, d, b) < 0.0
-}
-
-fn inside_convex(poly: &[DVec2; 4], p: DVec2) -> bool {
-    (0..4).all(|i| (poly[(i + 1) % 4] - poly[i]).perp_dot(p - poly[i]) >= 0.0)
-}
-
 /// The distance between two convex quadrilaterals (0 when they overlap).
 fn box_distance(p: &[DVec2; 4], q: &[DVec2; 4]) -> f64 {
-    if inside_convex(p, q[0]) || inside_convex(q, p[0]) {
+    if inside(p, q[0]) || inside(q, p[0]) {
         return 0.0;
     }
-    let mut best = f64::MAX;
-    for i in 0..4 {
-        let (a, b) = (p[i], p[(i + 1) % 4]);
-        for j in 0..4 {
-            let (c, d) = (q[j], q[(j + 1) % 4]);
-            if crosses(a, b, c, d) {
-                return 0.0;
-            }
-            best = best.min(point_segment(a, c, d)).min(point_segment(c, a, b));
-        }
-    }
-    best
+    (0..4)
+        .flat_map(|i| (0..4).map(move |j| (i, j)))
+        .map(|(i, j)| segment_distance(p[i], p[(i + 1) % 4], q[j], q[(j + 1) % 4]))
+        .fold(f64::MAX, f64::min)
 }
 
 /// What the labels of one build look like.
@@ -150,18 +127,16 @@ fn survey(
                 );
             }
         }
-        let uneven = [LabelKind::Panel, LabelKind::Partner, LabelKind::Mark]
-            .into_iter()
-            .any(|kind| {
-                let heights = panel
-                    .labels
-                    .iter()
-                    .filter(|l| l.kind == kind)
-                    .map(|l| l.height);
-                let lo = heights.clone().fold(f64::MAX, f64::min);
-                let hi = heights.fold(0.0, f64::max);
-                hi > lo * (1.0 + 1e-9)
-            });
+        let uneven = LabelKind::ALL.into_iter().any(|kind| {
+            let heights = panel
+                .labels
+                .iter()
+                .filter(|l| l.kind == kind)
+                .map(|l| l.height);
+            let lo = heights.clone().fold(f64::MAX, f64::min);
+            let hi = heights.fold(0.0, f64::max);
+            hi > lo * (1.0 + 1e-9)
+        });
         s.uneven_panels += usize::from(uneven);
     }
     s

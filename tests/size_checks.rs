@@ -11,7 +11,8 @@ use std::path::Path;
 use tempfile::TempDir;
 
 use common::build::{
-    assert_refusal, count, finish, model, read_manifest, shared_models, unfold_command, Run,
+    assert_refusal, count, finish, model, number_after, read_manifest, shared_models,
+    unfold_command, Run,
 };
 
 fn build(model: &Path, out: &Path, args: &[&str]) -> Run {
@@ -170,12 +171,8 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
             &out,
             &["too detailed for its size", "--target-edges "],
         );
-        let at = run.stderr.find("--target-edges ").unwrap() + "--target-edges ".len();
-        let budget: String = run.stderr[at..]
-            .chars()
-            .take_while(char::is_ascii_digit)
-            .collect();
-        let budget_edges: usize = budget.parse().unwrap();
+        let budget_edges = number_after(&run.stderr, "--target-edges ").unwrap();
+        let budget = budget_edges.to_string();
         assert!(
             budget_edges < 8784,
             "{scheme}: {budget_edges} edges suggested"

@@ -97,10 +97,13 @@ const TEXT_MAX: f64 = 3.0;
 /// capitals), for the collision test.
 const CHAR_WIDTH: f64 = 0.62;
 
-/// Page furniture (mm): the outer border, the title's line, and the legend's line.
+/// Page furniture (mm): the outer border, the title's line, the legend's line, and
+/// the strip at the top of each view's cell for its caption (the drawing keeps as much
+/// free below it).
 const BORDER: f64 = 8.0;
 const TITLE: f64 = 10.0;
 const LEGEND: f64 = 16.0;
+const CAPTION: f64 = 3.0;
 
 /// What the map is drawn from.
 pub struct MapInput<'a> {
@@ -145,7 +148,7 @@ pub fn assembly_map(input: &MapInput) -> String {
     let (cols, rows, scale) = [(2usize, 3usize), (3, 2), (1, 6), (6, 1)]
         .into_iter()
         .map(|(c, r)| {
-            let (cw, ch) = (area_w / c as f64, area_h / r as f64 - TEXT_MAX * 2.0);
+            let (cw, ch) = (area_w / c as f64, area_h / r as f64 - 2.0 * CAPTION);
             let s = extents
                 .iter()
                 .map(|(lo, hi)| {
@@ -197,7 +200,7 @@ pub fn assembly_map(input: &MapInput) -> String {
         let (lo, hi) = extents[k];
         let centre = 0.5 * (lo + hi);
         // Page point of a model point: the view's (right, up) scaled, y down.
-        let origin = cell_lo + DVec2::new(0.5 * cell_w, 0.5 * (cell_h + TEXT_MAX))
+        let origin = cell_lo + DVec2::new(0.5 * cell_w, 0.5 * (cell_h + CAPTION))
             - scale * DVec2::new(centre.x, -centre.y);
         let to_page = |p: DVec3| {
             let q = project(p, view);
@@ -215,11 +218,12 @@ pub fn assembly_map(input: &MapInput) -> String {
         );
         let _ = writeln!(
             out,
-            "<text x=\"{}\" y=\"{}\" font-size=\"4.5\">{} (from {}, turned 20° toward {})</text>",
+            "<text x=\"{}\" y=\"{}\" font-size=\"4.5\">{} (from {}, turned {:.0}° toward {})</text>",
             fmt_mm(cell_lo.x + 2.0),
             fmt_mm(cell_lo.y + 5.0),
             view.name,
             view.axis,
+            TILT.atan().to_degrees(),
             view.turn
         );
         // Far to near; back faces of a closed model are never seen.

@@ -15,7 +15,7 @@ use glam::DVec2;
 
 use crate::font::text_strokes;
 use crate::nest::{Layout, Placement};
-use crate::panel::{label_extent, FlatPanelRef, FlatPanels};
+use crate::panel::{label_box, label_extent, FlatPanelRef, FlatPanels};
 
 /// The three kinds of laser geometry.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -208,14 +208,7 @@ fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetS
         }
         if label.frame > 0.0 {
             let (w, across) = label_extent(label.frame, strokes.width, h);
-            let center = placement.apply(label.center);
-            let (along, side) = (0.5 * w * d, 0.5 * across * up);
-            let frame = [
-                center - along - side,
-                center + along - side,
-                center + along + side,
-                center - along + side,
-            ];
+            let frame = label_box(placement.apply(label.center), d, w, across);
             sink.polyline(Kind::Engrave, &frame, true);
         }
     }

@@ -251,19 +251,35 @@ pub const MAX_FACE_SCALE: f64 = 0.9;
 /// Steps from `--face-scale` to [`MAX_FACE_SCALE`] tried for such a face.
 const BAND_STEPS: u32 = 4;
 
+/// Which corners make an edge scheme widen a face's band.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WidenFor {
+    /// Corners that hold no hole.
+    Bare,
+    /// Corners that hold fewer holes than wanted (none included).
+    Short,
+}
+
 /// A face's flaps `first` (at the options' face scale); where a corner cannot hold a
-/// hole (with `widen_short`, all its holes) even so, the face's band widened (its
+/// hole (with [`WidenFor::Short`], all its holes) even so, the face's band widened (its
 /// corners nearer the face's own), step by step with `flaps_in_band`, kept where it
 /// leaves fewer corners bare, or as many bare and fewer short of holes. The bends stay
 /// developable: each band edge stays parallel to its mesh edge whatever the scale.
-pub fn widened_where_bare(
+fn widened_band(
     options: &EdgeOptions,
-    widen_short: bool,
+    widen: WidenFor,
     first: FaceFlaps,
     flaps_in_band: impl Fn(&EdgeOptions) -> FaceFlaps,
 ) -> FaceFlaps {
     let scale = options.panel.face_scale;
-    let shortfall = |f: &FaceFlaps| (f.bare.len(), if widen_short { f.reduced } else { 0 });
+    let shortfall = |f: &FaceFlaps| {
+        let short = if widen == WidenFor::Short {
+            f.reduced
+        } else {
+            0
+        };
+        (f.bare.len(), short)
+    };
     if shortfall(&first) == (0, 0) || scale >= MAX_FACE_SCALE {
         return first;
     }
@@ -334,45 +350,19 @@ pub fn place_pins(
 }
 
 /// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
-/// face order), widened where corners need it (see [`widened_where_bare`]; where a
-/// corner holds fewer holes than wanted too, with `widen_short`), then the panels, the
+/// face order), widened where corners need it ([`widen_bands`]), then the panels, the
 /// connection count (one per face corner) and the report lines.
 pub fn edge_scheme(
     mesh: &Mesh,
     options: &EdgeOptions,
-    widen_short: bool,
+    widen: WidenFor,
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> super::SchemeOutput {
     let mut faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
         .into_par_iter()
         .map(|f| face_flaps(mesh, FaceId(f), options))
         .collect();
-    let needs = |f: &FaceFlaps| !f.bare.is_empty() || (widen_short && f.reduced > 0);
-    let widened: Vec<(usize, FaceFlaps)> = (0..faces.len())
-        .into_par_iter()
-        .filter(|&k| needs(&faces[k]))
-        .map(|k| {
-            let f = FaceId(k as u32);
-            let flaps = widened_where_bare(options, widen_short, faces[k].clone(), |o| {
-                face_flaps(mesh, f, o)
-            });
-            (k, flaps)
-        })
-        .collect();
-    // A model still too detailed for its fasteners with widened bands (the build warns
-    // with a budget) keeps its own bands: wider ones would cost sheets for a panel set
-    // that cannot be assembled as asked anyway.
-    let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
-    let bare_after: usize = faces.iter().map(|f| f.bare.len()).sum::<usize>()
-        - widened
-            .iter()
-            .map(|(k, w)| faces[*k].bare.len() - w.bare.len())
-            .sum::<usize>();
-    if (bare_after as f64) <= super::MOST_UNFASTENED * corners as f64 {
-        for (k, flaps) in widened {
-            faces[k] = flaps;
-        }
-    }
+    widen_bands(mesh, options, widen, &face_flaps, &mut faces);
     let panels = edge_panels(mesh, &faces, options);
     let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
     super::SchemeOutput {
@@ -381,6 +371,44 @@ pub fn edge_scheme(
         notes: edge_scheme_notes(mesh, &faces, connections, options),
         unfastened: unfastened(mesh, &faces),
         ..super::SchemeOutput::default()
+    }
+}
+
+/// Widens the bands of the faces whose corners need room ([`widened_band`]), unless
+/// the model stays too detailed for its fasteners even then (more than
+/// [`super::MOST_UNFASTENED`] of the corners bare; the build warns with a budget): it
+/// keeps its own bands, since wider ones would cost sheets for a panel set that cannot
+/// be assembled as asked anyway.
+fn widen_bands(
+    mesh: &Mesh,
+    options: &EdgeOptions,
+    widen: WidenFor,
+    face_flaps: &(impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync),
+    faces: &mut [FaceFlaps],
+) {
+    let needs = |f: &FaceFlaps| !f.bare.is_empty() || (widen == WidenFor::Short && f.reduced > 0);
+    let widened: Vec<(usize, FaceFlaps)> = (0..faces.len())
+        .into_par_iter()
+        .filter(|&k| needs(&faces[k]))
+        .map(|k| {
+            let f = FaceId(k as u32);
+            let first = faces[k].clone();
+            (
+                k,
+                widened_band(options, widen, first, |o| face_flaps(mesh, f, o)),
+            )
+        })
+        .collect();
+    let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
+    let bare_before: usize = faces.iter().map(|f| f.bare.len()).sum();
+    let fastened: usize = widened
+        .iter()
+        .map(|(k, w)| faces[*k].bare.len() - w.bare.len())
+        .sum();
+    if ((bare_before - fastened) as f64) <= super::MOST_UNFASTENED * corners as f64 {
+        for (k, flaps) in widened {
+            faces[k] = flaps;
+        }
     }
 }
 

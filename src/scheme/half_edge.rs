@@ -493,23 +493,24 @@ fn place_holes(
     let r = 0.5 * options.panel.hole_diameter;
     // The hole's radius and the margin of material to the tab's and the face's edges.
     let clearance = r + options.panel.hole_margin;
-    let along = |count: u32| -> Option<Vec<DVec2>> {
-        let v = 0.5 * (gap + top_height);
-        // The tab's extent at height v (it is convex: two crossings).
-        let mut xs = Vec::new();
-        for i in 0..tab.len() {
-            let (p, q) = (tab[i], tab[(i + 1) % tab.len()]);
-            if (p.y - v) * (q.y - v) <= 0.0 && p.y != q.y {
-                xs.push(p.x + (v - p.y) / (q.y - p.y) * (q.x - p.x));
-            }
+    let v = 0.5 * (gap + top_height);
+    // The tab's extent at height v (it is convex: two crossings).
+    let mut xs = Vec::new();
+    for i in 0..tab.len() {
+        let (p, q) = (tab[i], tab[(i + 1) % tab.len()]);
+        if (p.y - v) * (q.y - v) <= 0.0 && p.y != q.y {
+            xs.push(p.x + (v - p.y) / (q.y - p.y) * (q.x - p.x));
         }
-        let (Some(u0), Some(u1)) = (
-            xs.iter().copied().reduce(f64::min),
-            xs.iter().copied().reduce(f64::max),
-        ) else {
-            return None;
-        };
-        let band: Vec<DVec2> = neighbour_band.iter().map(|&p| to2(p)).collect();
+    }
+    let (Some(u0), Some(u1)) = (
+        xs.iter().copied().reduce(f64::min),
+        xs.iter().copied().reduce(f64::max),
+    ) else {
+        return (Vec::new(), true);
+    };
+    let band: Vec<DVec2> = neighbour_band.iter().map(|&p| to2(p)).collect();
+    // `count` holes evenly along the middle of the tab, if they all fit.
+    let along = |count: u32| -> Option<Vec<DVec2>> {
         let centres: Vec<DVec2> = (1..=count)
             .map(|k| DVec2::new(u0 + (u1 - u0) * k as f64 / (count + 1) as f64, v))
             .collect();

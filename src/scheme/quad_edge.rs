@@ -20,7 +20,7 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps, WidenFor,
     EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
@@ -82,7 +82,7 @@ impl Configured for EdgeOptions {
 
 /// Builds the edge panels of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
-    edge_scheme(mesh, options, true, flaps_in_band)
+    edge_scheme(mesh, options, WidenFor::Short, flaps_in_band)
 }
 
 /// The deepest a flap grows, in units of its band edge's distance from the face centre
@@ -106,9 +106,8 @@ struct Corner {
 /// flap starts at `--flap-scale`; where a corner's overlap cannot hold its holes, the
 /// two flaps meeting there grow (to the smallest depth that holds the most holes that
 /// fit by [`MAX_FLAP_SCALE`]), so every connection gets its fasteners where the face has
-/// room for them.
-/// Band, flaps and corner overlaps of one face in the band of `options`' face scale
-/// (the scheme widens it where corners need room: [`edge_scheme`]).
+/// room for them; the scheme widens the band itself where corners still need room
+/// ([`edge_scheme`]).
 fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();

@@ -16,7 +16,7 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps, WidenFor,
     EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
@@ -110,7 +110,7 @@ pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
     // Where a corner holds no hole, the face's band widens as in quad-edge (the
     // wings do not grow); not for fewer holes than wanted, which the two shared
     // regions of a corner usually are, and wider bands there cost sheets.
-    edge_scheme(mesh, &options.edge, false, |mesh, f, edge| {
+    edge_scheme(mesh, &options.edge, WidenFor::Bare, |mesh, f, edge| {
         face_flaps(mesh, f, edge, shift)
     })
 }
@@ -185,13 +185,17 @@ fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions, shift: i32) -> Face
             parts.add_hole([*e1, *e2], frame.to3(pin), connection);
         }
     }
-    parts.reduced = short_at_corner.iter().filter(|&&s| s).count();
     if options.panel.holes > 0 {
         parts.bare = (0..n)
             .filter(|&k| placed_at_corner[k] == 0)
             .map(|k| half_edges[k])
             .collect();
     }
+    // A bare corner is short of holes too (the notes count the short ones with at
+    // least one hole as `reduced - bare`).
+    parts.reduced = (0..n)
+        .filter(|&k| short_at_corner[k] || (options.panel.holes > 0 && placed_at_corner[k] == 0))
+        .count();
     parts.shrink_to_fit();
     parts
 }

@@ -267,6 +267,44 @@ pub fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Distance from a point to a segment.
+pub fn point_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    p.distance(a + t * (b - a))
+}
+
+/// Distance between two segments (0 when they cross).
+pub fn segment_distance(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> f64 {
+    let orient = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
+    let (o1, o2) = (orient(a, b, c), orient(a, b, d));
+    let (o3, o4) = (orient(c, d, a), orient(c, d, b));
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return 0.0;
+    }
+    point_segment(a, c, d)
+        .min(point_segment(b, c, d))
+        .min(point_segment(c, a, b))
+        .min(point_segment(d, a, b))
+}
+
+/// The number written after `key` in `text` (`--target-edges 430` → 430), if any.
+pub fn number_after(text: &str, key: &str) -> Option<usize> {
+    let at = text.find(key)? + key.len();
+    text[at..]
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect::<String>()
+        .parse()
+        .ok()
+}
+
+/// The manifest's count of connections without a fastener hole.
+pub fn connections_without_holes(manifest: &Value) -> usize {
+    manifest["counts"]["connections_by_holes"]["0"]
+        .as_u64()
+        .unwrap_or(0) as usize
+}
+
 // =======================================================================================
 // Checking the sheets of an output folder
 // =======================================================================================
