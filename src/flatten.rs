@@ -11,7 +11,8 @@ use glam::{DVec2, DVec3};
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
 use crate::panel::{
-    fill_arena, Arena, FacetFrame, FlatHole, FlatPanel, FlatPanels, PanelRef, Panels,
+    fill_arena, Arena, FacetFrame, FlatHole, FlatPanel, FlatPanels, Fold, FoldKind, PanelRef,
+    Panels,
 };
 use crate::plane::loop_signed_area;
 
@@ -42,13 +43,13 @@ struct EdgeUse {
     to: u32,
 }
 
-/// Fold angles below this (radians) are not scored: the two facets are coplanar.
-const FLAT_FOLD: f64 = 1e-9;
+/// Fold angles up to this (radians) are not scored: the two facets are coplanar.
+pub const FLAT_FOLD: f64 = 1e-9;
 
 /// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
 /// first edge along +x); every other facet is placed across a hinge.
 pub fn flatten<'a>(panel: impl Into<PanelRef<'a>>) -> Result<FlatPanel, FlattenError> {
-    unroll(panel.into()).map(|(flat, _)| flat)
+    unroll(panel.into(), FLAT_FOLD).map(|(flat, _)| flat)
 }
 
 /// The isometry of every facet of `panel` between 3D and the flat panel that
@@ -56,11 +57,12 @@ pub fn flatten<'a>(panel: impl Into<PanelRef<'a>>) -> Result<FlatPanel, FlattenE
 /// label). Flat panels do not keep it (a million panels would carry a hundred bytes
 /// per facet for it), so it is computed again, by the same unrolling, where wanted.
 pub fn facet_frames<'a>(panel: impl Into<PanelRef<'a>>) -> Result<Vec<FacetFrame>, FlattenError> {
-    unroll(panel.into()).map(|(_, frames)| frames)
+    unroll(panel.into(), FLAT_FOLD).map(|(_, frames)| frames)
 }
 
-/// The flat panel and its facet frames.
-fn unroll(panel: PanelRef) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
+/// The flat panel and its facet frames; hinges that fold by `flat_fold` (radians) or
+/// less are not scored.
+fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
     let fail_id = || panel.id().to_string();
     let normals: Vec<DVec3> = panel
         .facets
@@ -96,18 +98,28 @@ fn unroll(panel: PanelRef) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError>
     edges.sort_by_key(|e| e.key);
     // Hinges as (facet, other facet, a, b), both ways, in edge order per facet.
     let mut hinges: Vec<(u32, u32, u32, u32)> = Vec::new();
-    let mut scores = Vec::new();
+    let mut folds = Vec::new();
     for users in edges.chunk_by(|x, y| x.key == y.key) {
         let (a, b) = users[0].key;
         match users {
             [_] => {}
-            [f, g] => {
-                let (f, g) = (f.facet, g.facet);
+            [f_use, g_use] => {
+                let (f, g) = (f_use.facet, g_use.facet);
                 hinges.push((f, g, a, b));
                 hinges.push((g, f, a, b));
-                let fold = normals[f as usize].angle_between(normals[g as usize]);
-                if fold > FLAT_FOLD {
-                    scores.push([a, b]);
+                let (nf, ng) = (normals[f as usize], normals[g as usize]);
+                if nf.angle_between(ng) > flat_fold {
+                    // Facets wind counter-clockwise seen from outside: the edge runs
+                    // from → to in f, and the normals turn about it the positive way
+                    // exactly when the edge is convex.
+                    let along =
+                        panel.vertices[f_use.to as usize] - panel.vertices[f_use.from as usize];
+                    let kind = if nf.cross(ng).dot(along) > 0.0 {
+                        FoldKind::Mountain
+                    } else {
+                        FoldKind::Valley
+                    };
+                    folds.push(Fold { ends: [a, b], kind });
                 }
             }
             _ => {
@@ -198,7 +210,7 @@ fn unroll(panel: PanelRef) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError>
         source: panel.source,
         points,
         outline: outline.into_iter().collect(),
-        scores,
+        folds,
         holes,
         labels: Vec::new(),
         developability_error,
@@ -213,22 +225,33 @@ pub fn unroll_and_fit<'a>(
     panel: impl Into<PanelRef<'a>>,
     options: LabelOptions,
 ) -> Result<(FlatPanel, LeftOut), FlattenError> {
-    let panel = panel.into();
-    let (mut flat, frames) = unroll(panel)?;
+    unroll_fit(panel.into(), options, FLAT_FOLD)
+}
+
+/// [`unroll_and_fit`], scoring only hinges that fold by more than `flat_fold`.
+fn unroll_fit(
+    panel: PanelRef,
+    options: LabelOptions,
+    flat_fold: f64,
+) -> Result<(FlatPanel, LeftOut), FlattenError> {
+    let (mut flat, frames) = unroll(panel, flat_fold)?;
     let left_out = fit_labels(&mut flat, panel, &frames, options);
     Ok((flat, left_out))
 }
 
 /// Unrolls every panel and fits its labels (the pipeline's flatten stage), in
-/// parallel; the flat panels come in panel order, in one arena, with how many labels
-/// were left out. On failure the error is that of the first panel, in panel order,
-/// that fails, whatever the thread count.
+/// parallel, scoring the hinges that fold by more than `flat_fold` (radians; the
+/// scheme's, or [`FLAT_FOLD`]); the flat panels come in panel order, in one arena,
+/// with how many labels were left out. On failure the error is that of the first
+/// panel, in panel order, that fails, whatever the thread count.
 pub fn unroll_all(
     panels: &Panels,
     options: LabelOptions,
+    flat_fold: f64,
 ) -> Result<(FlatPanels, LeftOut), FlattenError> {
-    let Unrolled { mut flat, left_out } =
-        fill_arena(panels.len(), |i| unroll_and_fit(panels.get(i), options))?;
+    let Unrolled { mut flat, left_out } = fill_arena(panels.len(), |i| {
+        unroll_fit(panels.get(i), options, flat_fold)
+    })?;
     flat.shrink_to_fit();
     Ok((flat, left_out))
 }
@@ -339,7 +362,14 @@ mod tests {
         // Unrolled, the fold at x = 1 opens to a 2 x 1 rectangle.
         assert!(flat.points[4].distance(DVec2::new(2.0, 0.0)) < 1e-12);
         assert!(flat.points[5].distance(DVec2::new(2.0, 1.0)) < 1e-12);
-        assert_eq!(flat.scores, vec![[1, 2]]);
+        // Folded up towards the first facet's outside: a valley.
+        assert_eq!(
+            flat.folds,
+            vec![Fold {
+                ends: [1, 2],
+                kind: FoldKind::Valley
+            }]
+        );
         assert_eq!(flat.outline.len(), 1);
         assert_eq!(flat.outline[0].len(), 6);
         assert!(signed_area(&flat.outer()) > 0.0, "outside face up");
@@ -351,13 +381,24 @@ mod tests {
     }
 
     #[test]
+    fn folded_away_from_the_outside_is_a_mountain() {
+        let mut panel = folded_strip();
+        panel.vertices[4] = DVec3::new(1.0, 0.0, -1.0);
+        panel.vertices[5] = DVec3::new(1.0, 1.0, -1.0);
+        panel.holes.clear();
+        let flat = flatten(&panel).unwrap();
+        assert_eq!(flat.folds.len(), 1);
+        assert_eq!(flat.folds[0].kind, FoldKind::Mountain);
+    }
+
+    #[test]
     fn coplanar_facets_are_not_scored() {
         let mut panel = folded_strip();
         panel.vertices[4] = DVec3::new(2.0, 0.0, 0.0);
         panel.vertices[5] = DVec3::new(2.0, 1.0, 0.0);
         panel.holes.clear();
         let flat = flatten(&panel).unwrap();
-        assert!(flat.scores.is_empty());
+        assert!(flat.folds.is_empty());
     }
 
     #[test]

@@ -7,7 +7,7 @@ use glam::DVec2;
 use crate::font::text_width;
 pub use crate::panel::label_box;
 use crate::panel::{
-    box_area, label_extent, FacetFrame, FlatLabel, FlatPanel, LabelKind, LoopsRef, PanelRef,
+    box_area, label_extent, FacetFrame, FlatLabel, FlatPanel, Fold, LabelKind, LoopsRef, PanelRef,
     FRAME_PAD, TIGHT_FRAME_PAD,
 };
 pub use crate::panel::{LeftOut, MIN_HEIGHT};
@@ -321,7 +321,7 @@ fn box_fits(
             return false;
         }
     }
-    for &[a, b] in &panel.scores {
+    for &Fold { ends: [a, b], .. } in &panel.folds {
         let (p, q) = (panel.points[a as usize], panel.points[b as usize]);
         if contains(bx, p) || (0..4).any(|k| segments_intersect(p, q, bx[k], bx[(k + 1) % 4])) {
             return false;

@@ -32,15 +32,18 @@ pub enum Source {
         /// The segment along it.
         segment: u32,
     },
+    /// An island of faces joined along folds (net scheme), numbered from 1.
+    Island(u32),
 }
 
 impl Source {
-    /// The id printed for users (`F12`, `E123`, `C3.2`).
+    /// The id printed for users (`F12`, `E123`, `C3.2`, `N4`).
     pub fn name(self) -> Name {
         match self {
             Source::Face(f) => Name::Face(f),
             Source::Edge(e) => Name::Edge(e),
             Source::Cycle { cycle, segment } => Name::Segment { cycle, segment },
+            Source::Island(k) => Name::Island(k),
         }
     }
 }
@@ -64,6 +67,10 @@ pub enum Name {
         /// The segment along it (1-based).
         segment: u32,
     },
+    /// An island of a net: `N4` (1-based).
+    Island(u32),
+    /// The match number of a cut edge, the same on both sides: `17` (1-based).
+    Match(u32),
 }
 
 impl std::fmt::Display for Name {
@@ -74,6 +81,8 @@ impl std::fmt::Display for Name {
             Name::Vertex(k) => write!(f, "V{k}"),
             Name::Cycle(k) => write!(f, "C{k}"),
             Name::Segment { cycle, segment } => write!(f, "C{cycle}.{segment}"),
+            Name::Island(k) => write!(f, "N{k}"),
+            Name::Match(k) => write!(f, "{k}"),
         }
     }
 }
@@ -681,6 +690,25 @@ impl FacetFrame {
     }
 }
 
+/// Which way a fold bends, seen from the outside of the model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FoldKind {
+    /// The crease points out of the model (a convex edge): a ridge seen from outside.
+    Mountain,
+    /// The crease points into the model (a concave edge): a trough seen from outside.
+    Valley,
+}
+
+/// A fold line to score: a hinge between two facets that are not coplanar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Fold {
+    /// Its two ends (indices into the flat panel's points).
+    pub ends: [u32; 2],
+    /// Mountain or valley, seen from the outside.
+    pub kind: FoldKind,
+}
+
 /// A hole in the flat panel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FlatHole {
@@ -727,7 +755,7 @@ pub struct FlatPanel {
     /// (clockwise).
     pub outline: Loops,
     /// Fold lines to score (hinges with a non-zero fold angle).
-    pub scores: Vec<[u32; 2]>,
+    pub folds: Vec<Fold>,
     /// Fastener holes.
     pub holes: Vec<FlatHole>,
     /// Labels after fitting.
@@ -745,7 +773,7 @@ impl FlatPanel {
             source: self.source,
             points: &self.points,
             outline: self.outline.view(),
-            scores: &self.scores,
+            folds: &self.folds,
             holes: &self.holes,
             labels: &self.labels,
             developability_error: self.developability_error,
@@ -781,7 +809,7 @@ pub struct FlatPanelRef<'a> {
     /// (clockwise).
     pub outline: LoopsRef<'a>,
     /// Fold lines to score.
-    pub scores: &'a [[u32; 2]],
+    pub folds: &'a [Fold],
     /// Fastener holes.
     pub holes: &'a [FlatHole],
     /// Labels after fitting.
@@ -814,7 +842,7 @@ impl FlatPanelRef<'_> {
             source: self.source,
             points: self.points.to_vec(),
             outline: self.outline.iter().map(|lp| lp.iter().copied()).collect(),
-            scores: self.scores.to_vec(),
+            folds: self.folds.to_vec(),
             holes: self.holes.to_vec(),
             labels: self.labels.to_vec(),
             developability_error: self.developability_error,
@@ -829,7 +857,7 @@ struct FlatStarts {
     points: u32,
     loop_indices: u32,
     loop_ends: u32,
-    scores: u32,
+    folds: u32,
     holes: u32,
     labels: u32,
 }
@@ -844,7 +872,7 @@ struct FlatHead {
 }
 
 /// The flat panels of a job, all in one arena: one buffer per kind of item (points,
-/// outline indices, scores, holes, labels) and a small head per panel saying where
+/// outline indices, folds, holes, labels) and a small head per panel saying where
 /// its items start. A big job has millions of flat panels of a dozen points each; as
 /// separate [`FlatPanel`]s they cost four allocations and a 176-byte struct apiece,
 /// more than their points. Panels are handed out as [`FlatPanelRef`]s.
@@ -854,7 +882,7 @@ pub struct FlatPanels {
     points: Vec<DVec2>,
     loop_indices: Vec<u32>,
     loop_ends: Vec<u32>,
-    scores: Vec<[u32; 2]>,
+    folds: Vec<Fold>,
     holes: Vec<FlatHole>,
     labels: Vec<FlatLabel>,
 }
@@ -884,7 +912,7 @@ impl FlatPanels {
         self.points.extend_from_slice(panel.points);
         self.loop_indices.extend_from_slice(panel.outline.indices);
         self.loop_ends.extend_from_slice(panel.outline.ends);
-        self.scores.extend_from_slice(panel.scores);
+        self.folds.extend_from_slice(panel.folds);
         self.holes.extend_from_slice(panel.holes);
         self.labels.extend_from_slice(panel.labels);
         self.lens();
@@ -905,7 +933,7 @@ impl FlatPanels {
             points: arena_len(self.points.len()),
             loop_indices: arena_len(self.loop_indices.len()),
             loop_ends: arena_len(self.loop_ends.len()),
-            scores: arena_len(self.scores.len()),
+            folds: arena_len(self.folds.len()),
             holes: arena_len(self.holes.len()),
             labels: arena_len(self.labels.len()),
         }
@@ -917,7 +945,7 @@ impl FlatPanels {
         self.points.shrink_to_fit();
         self.loop_indices.shrink_to_fit();
         self.loop_ends.shrink_to_fit();
-        self.scores.shrink_to_fit();
+        self.folds.shrink_to_fit();
         self.holes.shrink_to_fit();
         self.labels.shrink_to_fit();
     }
@@ -941,7 +969,7 @@ impl FlatPanels {
                 indices: &self.loop_indices[range(start.loop_indices, end.loop_indices)],
                 ends: &self.loop_ends[range(start.loop_ends, end.loop_ends)],
             },
-            scores: &self.scores[range(start.scores, end.scores)],
+            folds: &self.folds[range(start.folds, end.folds)],
             holes: &self.holes[range(start.holes, end.holes)],
             labels: &self.labels[range(start.labels, end.labels)],
             developability_error: head.developability_error,
@@ -987,7 +1015,7 @@ impl Arena for FlatPanels {
         self.points.extend_from_slice(&other.points);
         self.loop_indices.extend_from_slice(&other.loop_indices);
         self.loop_ends.extend_from_slice(&other.loop_ends);
-        self.scores.extend_from_slice(&other.scores);
+        self.folds.extend_from_slice(&other.folds);
         self.holes.extend_from_slice(&other.holes);
         self.labels.extend_from_slice(&other.labels);
         // Checked before the shift: no shifted start can pass the new lengths.
@@ -999,7 +1027,7 @@ impl Arena for FlatPanels {
                     points: s.points + offset.points,
                     loop_indices: s.loop_indices + offset.loop_indices,
                     loop_ends: s.loop_ends + offset.loop_ends,
-                    scores: s.scores + offset.scores,
+                    folds: s.folds + offset.folds,
                     holes: s.holes + offset.holes,
                     labels: s.labels + offset.labels,
                 },
@@ -1205,7 +1233,7 @@ mod tests {
     }
 
     /// The flat counterpart of [`fan`]: points, an outline with an inner loop on odd
-    /// panels, scores on every other.
+    /// panels, folds on every other.
     fn flat_fan(k: u32) -> FlatPanel {
         let panel = fan(k);
         let mut outline = Loops::new();
@@ -1217,7 +1245,12 @@ mod tests {
             source: panel.source,
             points: panel.vertices.iter().map(|v| v.truncate()).collect(),
             outline,
-            scores: (0..k % 2).map(|i| [0, i + 2]).collect(),
+            folds: (0..k % 2)
+                .map(|i| Fold {
+                    ends: [0, i + 2],
+                    kind: FoldKind::Valley,
+                })
+                .collect(),
             holes: (0..k % 3)
                 .map(|i| FlatHole {
                     center: DVec2::splat(i as f64),

@@ -22,7 +22,7 @@ use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 
 use crate::nest::{lay_out, Layout, SheetSpec};
-use crate::panel::{FlatPanelRef, FlatPanels, Source};
+use crate::panel::{FlatPanelRef, FlatPanels, FoldKind, Source};
 use crate::plane::is_simple;
 use crate::scheme::SchemeOutput;
 
@@ -272,7 +272,8 @@ pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
 /// itself is an error naming it.
 pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<Flat> {
     let mesh = &prepared.scheme_mesh.mesh;
-    let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default())
+    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default(), flat_fold)
         .map_err(|e| Error::internal("unrolling the panels", e))?;
     let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out)?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
@@ -420,6 +421,7 @@ pub fn export(
         // Summed in sheet order, so the totals do not depend on the thread count.
         lengths.cut += sheet.lengths.cut;
         lengths.score += sheet.lengths.score;
+        lengths.score_valley += sheet.lengths.score_valley;
         lengths.engrave += sheet.lengths.engrave;
         sheet_entries.push(sheet.entry);
     }
@@ -429,8 +431,11 @@ pub fn export(
         assembled_obj(&output.panels).into_bytes(),
     ));
     if job.map {
-        let surface =
-            crate::panel::surface::panel_surface(&prepared.scheme_mesh.mesh, &output.panels);
+        let surface = crate::panel::surface::panel_surface(
+            &prepared.scheme_mesh.mesh,
+            &output.panels,
+            &output.islands,
+        );
         let map = crate::export::map::assembly_map(&crate::export::map::MapInput {
             surface: &surface,
             panels: &output.panels,
@@ -510,6 +515,13 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     })
 }
 
+/// Score lines of every panel that fold as `kind`.
+fn folds_of(flat: &FlatPanels, kind: FoldKind) -> usize {
+    flat.iter()
+        .map(|p| p.folds.iter().filter(|f| f.kind == kind).count())
+        .sum()
+}
+
 fn build_manifest(
     job: &Job,
     prepared: &Prepared,
@@ -534,7 +546,7 @@ fn build_manifest(
     let lower_bound = (panel_area / usable).ceil() as usize;
     // Faces made by splitting or simplification have no face in the input file.
     let input_face = |f: u32| Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX);
-    let panels = manifest::panel_entries(flat, layout, input_face);
+    let panels = manifest::panel_entries(flat, layout, input_face, &output.islands);
     Manifest {
         tool: manifest::Tool {
             name: "unfold",
@@ -579,6 +591,8 @@ fn build_manifest(
             connections: output.connections,
             connections_by_holes: manifest::connections_by_holes(flat, output.connections),
             fasteners: flat.iter().map(|p| p.holes.len()).sum::<usize>() / 2,
+            folds_mountain: folds_of(flat, FoldKind::Mountain),
+            folds_valley: folds_of(flat, FoldKind::Valley),
             labels_left_out: labels_left_out.total(),
             panel_ids_left_out: labels_left_out.panel,
             partner_ids_left_out: labels_left_out.partner,
@@ -589,6 +603,7 @@ fn build_manifest(
         lengths: manifest::Lengths {
             cut: round4(lengths.cut),
             score: round4(lengths.score),
+            score_valley: round4(lengths.score_valley),
             engrave: round4(lengths.engrave),
         },
         scheme_sections: output.manifest.clone(),

@@ -188,7 +188,8 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     degrees.sort_unstable();
     let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
     smallest_edge(job, typical, |output| {
-        crate::flatten::unroll_all(&output.panels, LabelOptions::default())
+        let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+        crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
             .is_ok_and(|(_, left_out)| left_out.panel == 0 && left_out.partner == 0)
     })
 }

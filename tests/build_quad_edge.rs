@@ -34,7 +34,7 @@ use common::build::{
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use unfold::panel::{FlatPanel, Panel, Source};
+use unfold::panel::{FlatPanel, Fold, Panel, Source};
 use unfold::scheme::edge_panel::EdgeOptions;
 use unfold::scheme::quad_edge::MAX_FLAP_SCALE;
 
@@ -448,7 +448,7 @@ fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) 
             }
             let ruling_set: BTreeSet<(u32, u32)> =
                 lines.iter().map(|[a, b]| (*a.min(b), *a.max(b))).collect();
-            for [a, b] in &fp.scores {
+            for Fold { ends: [a, b], .. } in &fp.folds {
                 assert!(
                     ruling_set.contains(&(*a.min(b), *a.max(b))),
                     "{what}: {} scores {a}-{b}, which is not a ruling",
@@ -1099,7 +1099,7 @@ fn open_meshes_give_boundary_edges_a_single_flap() {
                 fp.id()
             );
             assert!(
-                fp.scores.is_empty(),
+                fp.folds.is_empty(),
                 "{what}: {} has no bend to score",
                 fp.id()
             );
@@ -1306,7 +1306,7 @@ fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
             m["max_developability_error"]
         );
         let sheets = check_sheets(&out, &m, DxfCheck::All);
-        let scores: usize = p.flat.iter().map(|fp| fp.scores.len()).sum();
+        let scores: usize = p.flat.iter().map(|fp| fp.folds.len()).sum();
         assert_eq!(
             sheets.total().score_paths,
             scores,
@@ -1314,7 +1314,7 @@ fn bend_strips_are_planar_and_ruled_parallel_to_the_edge() {
         );
         if name == "icosahedron" {
             for fp in &p.flat {
-                assert_eq!(fp.scores.len(), samples as usize + 1, "{what}: {}", fp.id());
+                assert_eq!(fp.folds.len(), samples as usize + 1, "{what}: {}", fp.id());
             }
         }
     }

@@ -21,7 +21,7 @@ Checks, beyond what ezdxf itself enforces:
     doc.dxfversion == "AC1009";
   * doc.audit() reports no errors and no fixes (a fix means the file as
     written needed repairing);
-  * layers CUT, SCORE, ENGRAVE exist with colours 1, 5, 7;
+  * layers CUT, SCORE, SCORE-VALLEY, ENGRAVE exist with colours 1, 5, 3, 7;
   * raw tag structure of the ENTITIES section: every POLYLINE is followed by
     its VERTEX entities and a SEQEND (ezdxf would silently accept a missing
     SEQEND), and no R13+ subclass markers (group code 100) appear anywhere;
@@ -32,7 +32,7 @@ Checks, beyond what ezdxf itself enforces:
 import json
 import sys
 
-LAYER_COLOURS = {"CUT": 1, "SCORE": 5, "ENGRAVE": 7}
+LAYER_COLOURS = {"CUT": 1, "SCORE": 5, "SCORE-VALLEY": 3, "ENGRAVE": 7}
 
 
 def fail(msg):

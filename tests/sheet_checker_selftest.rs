@@ -478,9 +478,10 @@ fn dxf(entities: &str) -> String {
 0\nTABLE\n2\nLTYPE\n70\n1\n\
 0\nLTYPE\n2\nCONTINUOUS\n70\n0\n3\nSolid line\n72\n65\n73\n0\n40\n0.0\n\
 0\nENDTAB\n\
-0\nTABLE\n2\nLAYER\n70\n3\n\
+0\nTABLE\n2\nLAYER\n70\n4\n\
 0\nLAYER\n2\nCUT\n70\n0\n62\n1\n6\nCONTINUOUS\n\
 0\nLAYER\n2\nSCORE\n70\n0\n62\n5\n6\nCONTINUOUS\n\
+0\nLAYER\n2\nSCORE-VALLEY\n70\n0\n62\n3\n6\nCONTINUOUS\n\
 0\nLAYER\n2\nENGRAVE\n70\n0\n62\n7\n6\nCONTINUOUS\n\
 0\nENDTAB\n\
 0\nENDSEC\n\

@@ -1,6 +1,6 @@
 //! DXF R12 (AC1009) per sheet, written by hand (LASER.md: the `dxf` crate writes
 //! R13-era markers, timestamps and random GUIDs). Closed and open POLYLINEs and
-//! CIRCLEs on layers CUT, SCORE, ENGRAVE, colour on the layer and on every entity.
+//! CIRCLEs on layers CUT, SCORE, SCORE-VALLEY, ENGRAVE, colour on the layer and on every entity.
 //! DXF's y axis points up like the sheet's, so coordinates go out unchanged (which is
 //! the SVG's `height − y`). Millimetres.
 
@@ -15,6 +15,7 @@ fn colour(kind: Kind) -> u8 {
     match kind {
         Kind::Cut => 1,
         Kind::Score => 5,
+        Kind::ScoreValley => 3,
         Kind::Engrave => 7,
     }
 }
@@ -23,7 +24,7 @@ fn colour(kind: Kind) -> u8 {
 pub struct DxfSheet {
     width: f64,
     height: f64,
-    entities: [String; 3],
+    entities: [String; 4],
 }
 
 impl DxfSheet {
@@ -74,8 +75,8 @@ impl DxfSheet {
         pair(0, "ENDTAB");
         pair(0, "TABLE");
         pair(2, "LAYER");
-        pair(70, "3");
-        for kind in [Kind::Cut, Kind::Score, Kind::Engrave] {
+        pair(70, &Kind::ALL.len().to_string());
+        for kind in [Kind::Cut, Kind::Score, Kind::ScoreValley, Kind::Engrave] {
             pair(0, "LAYER");
             pair(2, kind.layer());
             pair(70, "0");
@@ -89,7 +90,7 @@ impl DxfSheet {
         pair(0, "ENDSEC");
         pair(0, "SECTION");
         pair(2, "ENTITIES");
-        // Same order as the SVG: engrave, score, cut.
+        // Same order as the SVG: engrave, score, valley score, cut.
         let body: String = self.entities.concat();
         out.push_str(&body);
         let mut pair = |code: i32, value: &str| {

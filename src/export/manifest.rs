@@ -126,6 +126,10 @@ pub struct Counts {
     pub connections_by_holes: std::collections::BTreeMap<String, usize>,
     /// Fasteners needed: one per pair of holes (a hole through both panels).
     pub fasteners: usize,
+    /// Score lines that fold as mountains, seen from the outside of the model.
+    pub folds_mountain: usize,
+    /// Score lines that fold as valleys, seen from the outside of the model.
+    pub folds_valley: usize,
     /// Labels left out because no legible size fits (all kinds).
     pub labels_left_out: usize,
     /// Of those, panel ids.
@@ -139,8 +143,10 @@ pub struct Counts {
 pub struct Lengths {
     /// Cut.
     pub cut: f64,
-    /// Score.
+    /// Score: the SCORE layer (mountain folds as the sheets lie, and rulings).
     pub score: f64,
+    /// Score: the SCORE-VALLEY layer (valley folds as the sheets lie).
+    pub score_valley: f64,
     /// Engrave.
     pub engrave: f64,
 }
@@ -180,6 +186,16 @@ pub enum PanelSource {
         cycle: u32,
         /// Segment.
         segment: u32,
+    },
+    /// An island of faces (net scheme).
+    Island {
+        /// Island number (from 1).
+        island: u32,
+        /// Its faces, as indices in the prepared mesh.
+        faces: Vec<u32>,
+        /// The same in the input file (`null` for a face made by splitting or
+        /// simplification).
+        input_faces: Vec<Option<u32>>,
     },
 }
 
@@ -248,11 +264,13 @@ pub struct Manifest {
 }
 
 /// Every panel's entry: id, sheet, area, source (with its face in the input file, from
-/// `input_face`), placement and developability error, in panel order.
+/// `input_face`; an island's faces from `islands`), placement and developability error,
+/// in panel order.
 pub fn panel_entries(
     flat: &FlatPanels,
     layout: &Layout,
     input_face: impl Fn(u32) -> Option<u32>,
+    islands: &[Vec<u32>],
 ) -> Vec<PanelEntry> {
     flat.iter()
         .zip(&layout.placements)
@@ -267,6 +285,17 @@ pub fn panel_entries(
                 },
                 Source::Edge(e) => PanelSource::Edge { edge: e },
                 Source::Cycle { cycle, segment } => PanelSource::Cycle { cycle, segment },
+                Source::Island(island) => {
+                    let faces = islands
+                        .get(island as usize - 1)
+                        .cloned()
+                        .unwrap_or_default();
+                    PanelSource::Island {
+                        island,
+                        input_faces: faces.iter().map(|&f| input_face(f)).collect(),
+                        faces,
+                    }
+                }
             },
             x: round4(placement.translation.x),
             y: round4(placement.translation.y),

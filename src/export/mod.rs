@@ -1,5 +1,5 @@
 //! Writing finished sheets. One routine ([`draw_sheet`]) walks a sheet in the order
-//! lasers want (engrave, score, cut; within cut, each part's holes and inner cuts before
+//! lasers want (engrave, score, valley score, cut; within cut, each part's holes and inner cuts before
 //! its outline) and feeds a [`SheetSink`]; the SVG and DXF writers are sinks, so both
 //! files carry exactly the same geometry.
 
@@ -15,26 +15,42 @@ use glam::DVec2;
 
 use crate::font::text_strokes;
 use crate::nest::{Layout, Placement};
-use crate::panel::{label_box, label_extent, FlatPanelRef, FlatPanels};
+use crate::panel::{label_box, label_extent, FlatPanelRef, FlatPanels, Fold, FoldKind};
 
-/// The three kinds of laser geometry.
+/// The kinds of laser geometry, in the order a sheet is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Kind {
     /// Marks: labels.
     Engrave,
-    /// Partial depth: fold lines.
+    /// Partial depth: mountain folds as the sheet lies (and Bézier rulings).
     Score,
+    /// Partial depth: valley folds as the sheet lies (the operator gives them other
+    /// power or scores them from the back).
+    ScoreValley,
     /// Through: outlines and holes.
     Cut,
 }
 
 impl Kind {
+    /// Every kind, in drawing order.
+    pub const ALL: [Kind; 4] = [Kind::Engrave, Kind::Score, Kind::ScoreValley, Kind::Cut];
+
     /// Layer name.
     pub fn layer(self) -> &'static str {
         match self {
             Kind::Engrave => "ENGRAVE",
             Kind::Score => "SCORE",
+            Kind::ScoreValley => "SCORE-VALLEY",
             Kind::Cut => "CUT",
+        }
+    }
+
+    /// The layer of a fold of `kind` on a part placed `mirrored` (cut face down, its
+    /// mountains are valleys from the top of the sheet, where the laser scores).
+    pub fn of_fold(kind: FoldKind, mirrored: bool) -> Kind {
+        match (kind, mirrored) {
+            (FoldKind::Mountain, false) | (FoldKind::Valley, true) => Kind::Score,
+            (FoldKind::Valley, false) | (FoldKind::Mountain, true) => Kind::ScoreValley,
         }
     }
 }
@@ -118,8 +134,10 @@ impl Format {
 pub struct Lengths {
     /// Cut length.
     pub cut: f64,
-    /// Score length.
+    /// Score length of mountain folds (as the sheets lie) and rulings.
     pub score: f64,
+    /// Score length of valley folds (as the sheets lie).
+    pub score_valley: f64,
     /// Engrave length.
     pub engrave: f64,
 }
@@ -143,6 +161,7 @@ impl Lengths {
         match kind {
             Kind::Cut => &mut self.cut,
             Kind::Score => &mut self.score,
+            Kind::ScoreValley => &mut self.score_valley,
             Kind::Engrave => &mut self.engrave,
         }
     }
@@ -160,9 +179,22 @@ pub fn draw_sheet(layout: &Layout, index: usize, panels: &FlatPanels, sink: &mut
     }
     for p in &on_sheet {
         let panel = panels.get(p.part);
-        for &[a, b] in panel.scores {
-            let line = [panel.points[a as usize], panel.points[b as usize]].map(|q| p.apply(q));
-            sink.polyline(Kind::Score, &line, false);
+        for fold in panel
+            .folds
+            .iter()
+            .filter(|f| Kind::of_fold(f.kind, p.mirrored) == Kind::Score)
+        {
+            draw_fold(panel, p, fold, sink);
+        }
+    }
+    for p in &on_sheet {
+        let panel = panels.get(p.part);
+        for fold in panel
+            .folds
+            .iter()
+            .filter(|f| Kind::of_fold(f.kind, p.mirrored) == Kind::ScoreValley)
+        {
+            draw_fold(panel, p, fold, sink);
         }
     }
     for p in &on_sheet {
@@ -183,6 +215,12 @@ pub fn draw_sheet(layout: &Layout, index: usize, panels: &FlatPanels, sink: &mut
             .collect();
         sink.polyline(Kind::Cut, &outer, true);
     }
+}
+
+/// A fold's score line, on its kind's layer.
+fn draw_fold(panel: FlatPanelRef, placement: &Placement, fold: &Fold, sink: &mut dyn SheetSink) {
+    let line = fold.ends.map(|i| placement.apply(panel.points[i as usize]));
+    sink.polyline(Kind::of_fold(fold.kind, placement.mirrored), &line, false);
 }
 
 /// A label's strokes: scaled to its cap height, its box centred on the label centre,

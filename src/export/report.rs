@@ -79,10 +79,13 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
     );
     let _ = writeln!(
         s,
-        "laser paths: cut {}, score {}, engrave {}",
+        "laser paths: cut {}, score {}, valley score {}, engrave {}; {} mountain and {} valley folds",
         path_length(m.lengths.cut),
         path_length(m.lengths.score),
-        path_length(m.lengths.engrave)
+        path_length(m.lengths.score_valley),
+        path_length(m.lengths.engrave),
+        m.counts.folds_mountain,
+        m.counts.folds_valley
     );
     // Exact panels carry only float noise, rounded away in the manifest.
     let error = m.max_developability_error;

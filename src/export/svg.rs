@@ -1,5 +1,5 @@
 //! SVG per sheet (LASER.md): physical size with a millimetre viewBox, one group per
-//! kind in the order engrave, score, cut, hairline strokes in pure colours, no fills,
+//! kind in the order engrave, score, valley score, cut, hairline strokes in pure colours, no fills,
 //! no text, no styles, fixed number format.
 
 use std::fmt::Write;
@@ -15,6 +15,8 @@ pub struct SvgStyle {
     pub cut: String,
     /// SCORE colour.
     pub score: String,
+    /// SCORE-VALLEY colour.
+    pub score_valley: String,
     /// ENGRAVE colour.
     pub engrave: String,
     /// Stroke width (mm).
@@ -26,6 +28,7 @@ impl Default for SvgStyle {
         Self {
             cut: "#FF0000".into(),
             score: "#0000FF".into(),
+            score_valley: "#00FF00".into(),
             engrave: "#000000".into(),
             stroke_width: 0.0254,
         }
@@ -37,7 +40,7 @@ pub struct SvgSheet {
     width: f64,
     height: f64,
     style: SvgStyle,
-    groups: [String; 3],
+    groups: [String; 4],
 }
 
 impl SvgSheet {
@@ -55,6 +58,7 @@ impl SvgSheet {
         let colour = match kind {
             Kind::Cut => &self.style.cut,
             Kind::Score => &self.style.score,
+            Kind::ScoreValley => &self.style.score_valley,
             Kind::Engrave => &self.style.engrave,
         };
         format!(
@@ -78,10 +82,7 @@ impl SvgSheet {
             w = fmt_mm(self.width),
             h = fmt_mm(self.height)
         );
-        for (kind, body) in [Kind::Engrave, Kind::Score, Kind::Cut]
-            .iter()
-            .zip(&self.groups)
-        {
+        for (kind, body) in Kind::ALL.iter().zip(&self.groups) {
             let _ = writeln!(
                 out,
                 "<g id=\"{}\" inkscape:groupmode=\"layer\" inkscape:label=\"{}\">",

@@ -2,7 +2,7 @@
 //! id is shown at, for the assembly map. A face panel covers its face; an edge panel
 //! the two triangles between its edge and the centres of the edge's faces (so the
 //! edge panels of a face share it like the slices of a cake); a woven segment its own
-//! ribbon, which lies over the surface.
+//! ribbon, which lies over the surface; an island its faces.
 
 use glam::DVec3;
 
@@ -34,30 +34,36 @@ pub struct PanelSurface {
     pub closed: bool,
 }
 
-/// Where the `panels` the scheme built from `mesh` sit on it.
-pub fn panel_surface(mesh: &Mesh, panels: &Panels) -> PanelSurface {
+/// Where the `panels` the scheme built from `mesh` sit on it; `islands` lists the faces
+/// of each island panel (`Source::Island(k)`: entry k − 1).
+pub fn panel_surface(mesh: &Mesh, panels: &Panels, islands: &[Vec<u32>]) -> PanelSurface {
+    let island = |k: u32| islands.get(k as usize - 1).map_or(&[][..], Vec::as_slice);
     PanelSurface {
-        patches: patches(mesh, panels),
+        patches: patches(mesh, panels, island),
         anchors: panels
             .iter()
-            .map(|p| anchor(mesh, p.source, p.vertices, p.facets.iter().collect()))
+            .map(|p| match p.source {
+                Source::Island(k) => island_anchor(mesh, island(k)),
+                _ => anchor(mesh, p.source, p.vertices, p.facets.iter().collect()),
+            })
             .collect(),
         closed: mesh.edges().all(|e| !mesh.is_boundary_edge(e)),
     }
 }
 
 /// The surface each panel covers (see the module's doc).
-fn patches(mesh: &Mesh, panels: &Panels) -> Vec<Patch> {
+fn patches<'a>(mesh: &Mesh, panels: &Panels, island: impl Fn(u32) -> &'a [u32]) -> Vec<Patch> {
     let mut patches = Vec::new();
+    let face_patch = |f: FaceId, k: usize| Patch {
+        points: mesh.face_positions(f).collect(),
+        normal: mesh.face_normal(f),
+        panel: k,
+    };
     for (k, panel) in panels.iter().enumerate() {
         match panel.source {
-            Source::Face(f) => {
-                let f = FaceId(f);
-                patches.push(Patch {
-                    points: mesh.face_positions(f).collect(),
-                    normal: mesh.face_normal(f),
-                    panel: k,
-                });
+            Source::Face(f) => patches.push(face_patch(FaceId(f), k)),
+            Source::Island(i) => {
+                patches.extend(island(i).iter().map(|&f| face_patch(FaceId(f), k)));
             }
             Source::Edge(e) => {
                 let h = EdgeId(e).half_edge();
@@ -92,6 +98,17 @@ fn patches(mesh: &Mesh, panels: &Panels) -> Vec<Patch> {
     patches
 }
 
+/// Where an island's id goes: the centre of its face nearest the middle of their
+/// centres.
+fn island_anchor(mesh: &Mesh, faces: &[u32]) -> DVec3 {
+    let centres: Vec<DVec3> = faces.iter().map(|&f| mesh.face_centre(FaceId(f))).collect();
+    let middle = centres.iter().copied().sum::<DVec3>() / centres.len().max(1) as f64;
+    centres
+        .into_iter()
+        .min_by(|a, b| a.distance(middle).total_cmp(&b.distance(middle)))
+        .unwrap_or(DVec3::ZERO)
+}
+
 /// Where a panel's id goes: its face's centre, its edge's midpoint, the centre of the
 /// middle facet of its ribbon.
 fn anchor(mesh: &Mesh, source: Source, vertices: &[DVec3], facets: Vec<&[u32]>) -> DVec3 {
@@ -101,7 +118,8 @@ fn anchor(mesh: &Mesh, source: Source, vertices: &[DVec3], facets: Vec<&[u32]>) 
             let (a, b) = mesh.edge_vertices(EdgeId(e));
             0.5 * (mesh.position(a) + mesh.position(b))
         }
-        Source::Cycle { .. } => {
+        // Islands are placed by `island_anchor`.
+        Source::Cycle { .. } | Source::Island(_) => {
             let Some(facet) = facets.get(facets.len() / 2) else {
                 return DVec3::ZERO;
             };

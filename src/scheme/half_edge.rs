@@ -22,19 +22,19 @@ use crate::record::{round4, Params};
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
 /// outline, plus the fastener holes through it and the neighbour.
 #[derive(Clone, Debug)]
-struct Tab {
+pub(super) struct Tab {
     /// Owner half-edge (a → b in the owner face).
-    owner: HalfedgeId,
+    pub(super) owner: HalfedgeId,
     /// Base points on the edge: a' near a, b' near b.
-    base: [DVec3; 2],
+    pub(super) base: [DVec3; 2],
     /// The tab outline after b', a' (so the tab facet is b', a', top…).
-    top: Vec<DVec3>,
+    pub(super) top: Vec<DVec3>,
     /// Hole centres (in the neighbour's plane).
-    holes: Vec<DVec3>,
+    pub(super) holes: Vec<DVec3>,
     /// The tab is lower than wanted.
-    shortened: bool,
+    pub(super) shortened: bool,
     /// Fewer holes than wanted fit (perhaps none).
-    holes_skipped: bool,
+    pub(super) holes_skipped: bool,
 }
 
 /// The tabs of a mesh's edges, kept sparse: on a fine mesh most edges have none (the
@@ -404,7 +404,7 @@ fn face_panel(
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
 /// `None` when the neighbour cannot hold one.
-fn make_tab(mesh: &Mesh, owner: HalfedgeId, options: &HalfEdgeOptions) -> Option<Tab> {
+pub(super) fn make_tab(mesh: &Mesh, owner: HalfedgeId, options: &HalfEdgeOptions) -> Option<Tab> {
     let g = mesh.face(owner.twin())?;
     let (a, b) = (
         mesh.position(mesh.origin(owner)),

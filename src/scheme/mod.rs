@@ -378,6 +378,12 @@ pub struct SchemeOutput {
     /// Connections that hold no fastener hole although holes were asked for (no room
     /// for one), in a deterministic order.
     pub unfastened: Vec<ConnectionName>,
+    /// The mesh faces of each island panel (`Source::Island(k)` is entry k − 1), each
+    /// list in increasing order.
+    pub islands: Vec<Vec<u32>>,
+    /// Hinges flatter than this angle (radians) are not scored; `None`: only exactly
+    /// flat ones are left unscored.
+    pub flat_fold: Option<f64>,
 }
 
 /// A build where more than this fraction of the connections holds no fastener hole

@@ -346,10 +346,12 @@ impl Sheets {
             t.holes += s.holes;
             t.cut_paths += s.cut_paths;
             t.score_paths += s.score_paths;
+            t.valley_paths += s.valley_paths;
             t.engrave_paths += s.engrave_paths;
             t.panel_area += s.panel_area;
             t.cut_length += s.cut_length;
             t.score_length += s.score_length;
+            t.valley_length += s.valley_length;
             t.engrave_length += s.engrave_length;
         }
         t
@@ -502,7 +504,8 @@ pub fn check_output(
     );
     for (kind, drawn) in [
         ("cut", total.cut_length),
-        ("score", total.score_length),
+        ("score", total.score_length - total.valley_length),
+        ("score_valley", total.valley_length),
         ("engrave", total.engrave_length),
     ] {
         let said = num(m, &format!("lengths.{kind}"));

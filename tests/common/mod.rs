@@ -6,7 +6,7 @@
 //! * [`check_svg_sheet`] — parses one SVG sheet with a small hand-written XML scanner and
 //!   checks syntax (declaration, root, groups, attributes, colours, number format) and
 //!   geometry (closed simple CUT loops, panels apart by `spacing`, margins, holes before
-//!   outlines, SCORE/ENGRAVE inside panels, nothing drawn twice). Returns [`SheetStats`].
+//!   outlines, SCORE/SCORE-VALLEY/ENGRAVE inside panels, nothing drawn twice). Returns [`SheetStats`].
 //! * [`parse_svg`] — the parser alone (syntax checks only), returning an [`SvgSheet`].
 //! * [`svg_geometry`] / [`svg_circles`] — paths and circles of a sheet (panic on a
 //!   malformed file: for tests that already checked the sheet).
@@ -53,40 +53,46 @@ pub struct SheetSpec {
 /// * `panels`: closed CUT paths not inside another closed CUT path.
 /// * `holes`: CUT circles (inner closed CUT paths are not counted here).
 /// * `cut_paths`: CUT `<path>` elements (panel outlines + inner cuts; circles excluded).
-/// * `score_paths`, `engrave_paths`: `<path>` elements of those groups.
+/// * `score_paths`, `engrave_paths`: `<path>` elements of those groups (score: SCORE
+///   and SCORE-VALLEY); `valley_paths`: those of SCORE-VALLEY alone.
 /// * `panel_area`: Σ |shoelace area| of panel outlines − Σ area of inner closed CUT
 ///   paths (circles are *not* subtracted).
 /// * `cut_length`: perimeters of all CUT paths (closing edge included) + circumferences
-///   2πr of the circles; `score_length`, `engrave_length`: polyline lengths.
+///   2πr of the circles; `score_length`, `valley_length`, `engrave_length`: polyline
+///   lengths.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct SheetStats {
     pub panels: usize,
     pub holes: usize,
     pub cut_paths: usize,
     pub score_paths: usize,
+    pub valley_paths: usize,
     pub engrave_paths: usize,
     pub panel_area: f64,
     pub cut_length: f64,
     pub score_length: f64,
+    pub valley_length: f64,
     pub engrave_length: f64,
 }
 
-/// The three kinds of laser geometry, in the order their groups must appear.
+/// The kinds of laser geometry, in the order their groups must appear.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Layer {
     Engrave,
     Score,
+    ScoreValley,
     Cut,
 }
 
 impl Layer {
-    pub const ALL: [Layer; 3] = [Layer::Engrave, Layer::Score, Layer::Cut];
+    pub const ALL: [Layer; 4] = [Layer::Engrave, Layer::Score, Layer::ScoreValley, Layer::Cut];
 
     /// Inkscape label and DXF layer name.
     pub fn name(self) -> &'static str {
         match self {
             Layer::Engrave => "ENGRAVE",
             Layer::Score => "SCORE",
+            Layer::ScoreValley => "SCORE-VALLEY",
             Layer::Cut => "CUT",
         }
     }
@@ -96,6 +102,7 @@ impl Layer {
         match self {
             Layer::Engrave => "engrave",
             Layer::Score => "score",
+            Layer::ScoreValley => "score-valley",
             Layer::Cut => "cut",
         }
     }
@@ -105,6 +112,7 @@ impl Layer {
         match self {
             Layer::Engrave => "#000000",
             Layer::Score => "#0000FF",
+            Layer::ScoreValley => "#00FF00",
             Layer::Cut => "#FF0000",
         }
     }
@@ -114,6 +122,7 @@ impl Layer {
         match self {
             Layer::Engrave => 7,
             Layer::Score => 5,
+            Layer::ScoreValley => 3,
             Layer::Cut => 1,
         }
     }
@@ -530,7 +539,7 @@ fn parse_mm(value: &str, what: &str) -> Result<f64, String> {
 /// Parses a sheet and performs every check that does not need the sheet spec or
 /// geometry: XML declaration, single `<svg>` root, allowed elements/attributes (no
 /// `<text>`, `<style>`, `style=`, `transform=`, `stroke-dasharray`), group ids/labels and
-/// order ENGRAVE, SCORE, CUT, paint attributes, number format, path syntax.
+/// order ENGRAVE, SCORE, SCORE-VALLEY, CUT, paint attributes, number format, path syntax.
 pub fn parse_svg(text: &str) -> Result<SvgSheet, String> {
     if text.contains("stroke-dasharray") {
         return Err("stroke-dasharray found: no dashes allowed".to_string());
@@ -651,7 +660,7 @@ pub fn parse_svg(text: &str) -> Result<SvgSheet, String> {
                 check_allowed_attrs(tag, &["id", "inkscape:groupmode", "inkscape:label"])?;
                 let id = required(tag, "id")?;
                 let layer = Layer::from_id(id).ok_or(format!(
-                    "group id=\"{id}\" at byte {}: expected engrave, score or cut",
+                    "group id=\"{id}\" at byte {}: expected engrave, score, score-valley or cut",
                     tag.pos
                 ))?;
                 if let Some(label) = tag.attr("inkscape:label") {
@@ -675,7 +684,7 @@ pub fn parse_svg(text: &str) -> Result<SvgSheet, String> {
                     }
                     if layer < last {
                         return Err(format!(
-                            "group {} after group {}: groups must be in the order ENGRAVE, SCORE, CUT",
+                            "group {} after group {}: groups must be in the order ENGRAVE, SCORE, SCORE-VALLEY, CUT",
                             layer.name(),
                             last.name()
                         ));
@@ -689,7 +698,7 @@ pub fn parse_svg(text: &str) -> Result<SvgSheet, String> {
                     (Some("g"), Some(l)) => l,
                     _ => {
                         return Err(format!(
-                            "<{}> at byte {} is not inside an ENGRAVE/SCORE/CUT group",
+                            "<{}> at byte {} is not inside an ENGRAVE/SCORE/SCORE-VALLEY/CUT group",
                             tag.name, tag.pos
                         ))
                     }
@@ -1287,7 +1296,7 @@ pub fn check_svg_sheet(text: &str, spec: &SheetSpec) -> Result<SheetStats, Strin
         }
     }
 
-    // --- SCORE and ENGRAVE inside panels ------------------------------------------------
+    // --- SCORE, SCORE-VALLEY and ENGRAVE inside panels ------------------------------------------------
     let panels: Vec<usize> = (0..nl).filter(|&q| is_panel[q]).collect();
     let inner_of: Vec<Vec<usize>> = (0..nl)
         .map(|q| (0..nl).filter(|&p| owner[p] == Some(q)).collect())
@@ -1358,6 +1367,12 @@ pub fn check_svg_sheet(text: &str, spec: &SheetSpec) -> Result<SheetStats, Strin
                 stats.score_paths += 1;
                 stats.score_length += len;
             }
+            Layer::ScoreValley => {
+                stats.score_paths += 1;
+                stats.score_length += len;
+                stats.valley_paths += 1;
+                stats.valley_length += len;
+            }
             Layer::Engrave => {
                 stats.engrave_paths += 1;
                 stats.engrave_length += len;
@@ -1378,7 +1393,7 @@ pub fn check_svg_sheet(text: &str, spec: &SheetSpec) -> Result<SheetStats, Strin
     Ok(stats)
 }
 
-/// Paths of a sheet as (layer name "CUT"/"SCORE"/"ENGRAVE", closed, normalised points in
+/// Paths of a sheet as (layer name "CUT"/"SCORE"/"SCORE-VALLEY"/"ENGRAVE", closed, normalised points in
 /// SVG coordinates), in document order. Circles are not included: see [`svg_circles`].
 /// Panics if the sheet does not parse (call [`check_svg_sheet`] first).
 pub fn svg_geometry(text: &str) -> Vec<(String, bool, Vec<Pt>)> {
@@ -1455,7 +1470,7 @@ fn dxf_items(json: &serde_json::Value) -> Result<Vec<Item>, String> {
         let ty = field("type").as_str().unwrap_or("?");
         let layer_name = field("layer").as_str().unwrap_or("?");
         let layer = Layer::from_name(layer_name).ok_or(format!(
-            "DXF entity #{i} ({ty}) is on layer {layer_name:?}; expected CUT, SCORE or ENGRAVE"
+            "DXF entity #{i} ({ty}) is on layer {layer_name:?}; expected CUT, SCORE, SCORE-VALLEY or ENGRAVE"
         ))?;
         match field("color").as_i64() {
             Some(c) if c == layer.dxf_color() => {}
@@ -1561,7 +1576,7 @@ fn match_items(left: &[Item], right: &[Item]) -> (Vec<Item>, Vec<Item>) {
 /// (layer, closed, points) polylines — LINE entities count as open two-point polylines —
 /// and (layer, centre, radius) circles, with SVG y flipped to `height − y` and
 /// coordinates equal within 1e-3 mm, points in the same order. Every entity must carry
-/// its layer's colour (CUT 1, SCORE 5, ENGRAVE 7).
+/// its layer's colour (CUT 1, SCORE 5, SCORE-VALLEY 3, ENGRAVE 7).
 ///
 /// If python3 or ezdxf is missing this fails with installation advice, unless
 /// `UNFOLD_SKIP_EZDXF=1`, in which case it prints a skip notice and returns Ok.
