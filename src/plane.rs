@@ -194,12 +194,16 @@ pub fn fits_rotated(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> bo
 }
 
 /// The rotation (among `steps` equal steps) with the smallest bounding box that fits
-/// `max_w` × `max_h`, turned to lie flat when that also fits.
+/// `max_w` × `max_h`, turned to lie flat when that also fits. Steps are counted from
+/// the outline's own axis (its smallest bounding rectangle laid flat), as the
+/// true-shape nester counts them: the frame an outline comes in means nothing.
 pub fn orient(outline: &[DVec2], steps: u32, max_w: f64, max_h: f64) -> Option<Oriented> {
     let steps = steps.max(1);
+    let axis = smallest_box_rotation(outline);
     let mut best: Option<(f64, Oriented)> = None;
     for k in 0..steps {
-        let rotation = std::f64::consts::TAU * k as f64 / steps as f64;
+        let rotation = (axis + std::f64::consts::TAU * k as f64 / steps as f64)
+            .rem_euclid(std::f64::consts::TAU);
         let turn = DVec2::from_angle(rotation);
         let (lo, hi) = bounds(outline.iter().map(|&p| turn.rotate(p)));
         let size = hi - lo;

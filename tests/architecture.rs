@@ -110,7 +110,14 @@ fn imports_of(dir: &str, banned: &[&str]) -> Vec<String> {
 
 #[test]
 fn schemes_are_named_only_in_their_own_files() {
-    let names = ["HalfEdge", "QuadEdge", "WingedEdge", "Woven"];
+    let names = [
+        "HalfEdge",
+        "QuadEdge",
+        "WingedEdge",
+        "Woven",
+        "NetOptions",
+        "net::Net",
+    ];
     let mut offences = Vec::new();
     for file in rust_files(&src()) {
         if file.starts_with(src().join("scheme")) {

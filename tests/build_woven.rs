@@ -16,8 +16,8 @@ use glam::DVec3;
 use tempfile::TempDir;
 
 use common::build::{
-    build, check_output, count, folder_files, frames_of, golden_build, model, options, pipeline,
-    resolve, unfold_command, DxfCheck,
+    assert_same_bytes_on_one_and_two_threads, build, check_output, count, frames_of, golden_build,
+    model, options, pipeline, resolve, DxfCheck,
 };
 use unfold::mesh::geometry::vector_area;
 use unfold::scheme::woven::{ribbons, PieceKind, WovenOptions};
@@ -239,21 +239,10 @@ fn ribbons_do_not_pass_through_each_other() {
 
 #[test]
 fn output_is_the_same_on_one_and_two_threads() {
-    let tmp = TempDir::new().unwrap();
-    let mut outputs = Vec::new();
-    for threads in ["1", "2"] {
-        let out = tmp.path().join(threads);
-        let run = common::build::finish(
-            unfold_command()
-                .env("RAYON_NUM_THREADS", threads)
-                .arg(model("torus-6x4"))
-                .args(["--scheme", "woven", "--size", "200mm", "--out"])
-                .arg(&out),
-        );
-        assert_eq!(run.code, Some(0), "{}", run.stderr);
-        outputs.push(folder_files(&out));
-    }
-    assert_eq!(outputs[0], outputs[1]);
+    assert_same_bytes_on_one_and_two_threads(
+        &model("torus-6x4"),
+        &["--scheme", "woven", "--size", "200mm"],
+    );
 }
 
 #[test]

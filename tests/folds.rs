@@ -146,7 +146,7 @@ fn check_folds(
                 _ => edge_under(mesh, p, q, tol),
             };
             if let Some(e) = edge {
-                if let Source::Face(_) | Source::Edge(_) = panel.source {
+                if let Source::Face(_) | Source::Edge(_) | Source::Island(_) = panel.source {
                     counts.on_edges += 1;
                     assert_eq!(
                         Some(fold.kind),
@@ -175,7 +175,7 @@ fn edge_kinds(mesh: &Mesh) -> BTreeMap<FoldKind, usize> {
 #[test]
 fn every_fold_of_genus3_has_the_kind_of_its_dihedral() {
     let tmp = TempDir::new().unwrap();
-    for scheme in ["half-edge", "quad-edge", "winged-edge", "woven"] {
+    for scheme in ["half-edge", "quad-edge", "winged-edge", "woven", "net"] {
         let job = job(scheme, &model("genus3"), "1ft", 0, &tmp.path().join(scheme));
         let p = pipeline(&job);
         let what = format!("genus3 {scheme}");
@@ -188,6 +188,10 @@ fn every_fold_of_genus3_has_the_kind_of_its_dihedral() {
             kinds.get(&FoldKind::Mountain).is_some() && kinds.get(&FoldKind::Valley).is_some(),
             "{what}: both kinds occur: {kinds:?}"
         );
+        if scheme == "net" {
+            // Every fold and every tab lies on a mesh edge.
+            assert_eq!(counts.on_edges, kinds.values().sum::<usize>(), "{what}");
+        }
         if scheme == "half-edge" {
             // One tab, so one fold, on every bent edge.
             assert_eq!(kinds, &mesh_kinds, "{what}");

@@ -413,7 +413,7 @@ fn legend(out: &mut String, input: &MapInput, page_h: f64, named: usize) {
     }
     let _ = writeln!(
         out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"3.5\">Ids: E edge panel (quad-edge, winged-edge), F face (half-edge panel; a face mark on a flap), V vertex mark, C woven cycle (C3.2: its segment 2). {named} of {} panels named here; an id too crowded in one view is named in another.</text>",
+        "<text x=\"{}\" y=\"{}\" font-size=\"3.5\">Ids: E edge panel, F face (half-edge panel; a mark on a flap), V vertex mark, C woven cycle (C3.2: its segment 2), N net island (numbers on a net pair the sides of a cut). {named} of {} panels named; one crowded out of a view is named in another.</text>",
         fmt_mm(BORDER),
         fmt_mm(y + 11.0),
         input.panels.len()

@@ -9,6 +9,7 @@
 
 pub mod edge_panel;
 pub mod half_edge;
+pub mod net;
 pub mod quad_edge;
 pub mod winged_edge;
 pub mod woven;
@@ -25,11 +26,12 @@ use crate::panel::{Name, Panels};
 use crate::record::{round4, Params};
 
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
-pub static SCHEMES: [&dyn Scheme; 4] = [
+pub static SCHEMES: [&dyn Scheme; 5] = [
     &half_edge::HalfEdge,
     &quad_edge::QuadEdge,
     &winged_edge::WingedEdge,
     &woven::Woven,
+    &net::Net,
 ];
 
 /// A panel scheme: what the command line, the config file and the pipeline need of it.

@@ -128,6 +128,30 @@ pub fn build_run(
     (read_manifest(out), run)
 }
 
+/// Asserts that `unfold MODEL ARGS --out …` writes the same bytes on one thread and on
+/// two.
+pub fn assert_same_bytes_on_one_and_two_threads(model: &Path, args: &[&str]) {
+    let tmp = tempfile::TempDir::new().unwrap();
+    let mut outputs = Vec::new();
+    for threads in ["1", "2"] {
+        let out = tmp.path().join(threads);
+        let run = finish(
+            unfold_command()
+                .env("RAYON_NUM_THREADS", threads)
+                .arg(model)
+                .args(args)
+                .arg("--out")
+                .arg(&out),
+        );
+        assert_eq!(run.code, Some(0), "{}", run.stderr);
+        outputs.push(folder_files(&out));
+    }
+    assert!(
+        outputs[0] == outputs[1],
+        "{model:?} {args:?}: output differs between 1 and 2 threads"
+    );
+}
+
 /// [`build_run`] without the run.
 pub fn build(scheme: &str, model: &Path, size: &str, out: &Path, extra: &[&str]) -> Value {
     build_run(scheme, model, size, out, extra).0

@@ -1,0 +1,1286 @@
+//! The net scheme: islands of many faces joined along folds, the way paper modellers
+//! unfold a mesh. Every face is in one island; an edge inside an island is a fold and
+//! every other interior edge a cut, glued by one tab.
+//!
+//! Islands grow greedily over the edges in order of their fold angle (flattest first,
+//! so the cuts fall on the sharp edges): an edge joins the islands of its two faces when
+//! the smaller one, turned about that edge into the larger one's plane, overlaps none of
+//! its faces, the union still fits the sheet and stays compact (its convex hull at most
+//! `--island-spread` times its area: sprawling islands waste the sheet between their
+//! arms). A second pass lets islands of a few faces join a neighbour whatever shape
+//! that makes. Faces of an island that meet at a
+//! folded corner may touch there; any other two keep [`ISLAND_GAP`] apart, so the
+//! outline stays a simple polygon with room for the laser. Each island is a tree of
+//! faces, so it unrolls exactly.
+//!
+//! Each cut edge then gets a tab on one side, made like the half-edge scheme's (in the
+//! partner face's plane, inside the triangle of the edge and the partner's centre, so
+//! tabs under one face never meet). Laid flat, a tab must keep clear of its island's
+//! other faces and tabs: where it does not, the other side is tried and the tab is
+//! lowered, and only where no height fits is it left out (and counted). Both sides of a
+//! cut carry the same match number.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3};
+
+use super::half_edge::{make_tab, HalfEdgeOptions, Tab};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelLimit, PanelOptions};
+use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
+use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
+use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::plane::{convex_hull, fits_rotated};
+use crate::record::{round4, Params};
+
+/// Least distance (mm) between two faces or tabs of one island that are not joined:
+/// the laser needs room between two cuts, and an outline that touches itself is not
+/// one loop.
+pub const ISLAND_GAP: f64 = 0.5;
+
+/// Slack (mm) kept when checking that an island fits the usable sheet.
+const FIT_SLACK: f64 = 4.0;
+
+/// Islands of at most this many faces join a neighbour whatever the shape they make:
+/// a handful of faces on their own are more to find and glue than they save on the
+/// sheets.
+const SMALL_ISLAND: usize = 6;
+
+/// Tab heights tried, as fractions of `--tab-height`, before a tab is left out.
+const TAB_STEPS: [f64; 3] = [1.0, 0.5, 0.25];
+
+/// The net scheme: islands of faces joined along folds, glue tabs on the cuts.
+pub struct Net;
+
+/// The net scheme's options as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct NetArgs {
+    /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
+    /// where the neighbour is smaller. [default: 8mm]
+    #[arg(long, value_name = "LENGTH")]
+    tab_height: Option<String>,
+
+    /// Most faces in one island (net scheme), for builders who want small pieces.
+    /// [default: no limit]
+    #[arg(long, value_name = "N")]
+    max_island_faces: Option<usize>,
+
+    /// Folds flatter than this angle in degrees are not scored (net scheme).
+    /// [default: 1]
+    #[arg(long, value_name = "DEGREES")]
+    flat_fold: Option<f64>,
+
+    /// Largest ratio of an island's convex hull to its area (net scheme, at least 1):
+    /// smaller keeps islands compact so they pack on fewer sheets, larger makes fewer
+    /// islands. [default: 2]
+    #[arg(long, value_name = "R")]
+    island_spread: Option<f64>,
+}
+
+/// The net scheme's options, resolved (lengths in mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NetOptions {
+    /// The options every scheme takes.
+    pub panel: PanelOptions,
+    /// Wanted tab height (mm).
+    pub tab_height: f64,
+    /// Most faces in one island.
+    pub max_island_faces: Option<usize>,
+    /// Folds flatter than this (radians) are not scored.
+    pub flat_fold: f64,
+    /// Largest ratio of an island's convex hull to its area.
+    pub island_spread: f64,
+}
+
+impl Scheme for Net {
+    fn name(&self) -> &'static str {
+        "net"
+    }
+
+    fn about(&self) -> &'static str {
+        "islands of many faces joined along folds, glue tabs on the cuts"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        args_of::<NetArgs>()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            face_scale: 1.0,
+            holes: 0,
+            holes_allowed: &[0, 1, 2],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // The overlap test separates convex polygons.
+        true
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        let args: NetArgs = values.parse()?;
+        if panel.face_scale != 1.0 {
+            return Err(format!(
+                "--face-scale: the net scheme keeps its faces whole (1), not {}; leave it out",
+                panel.face_scale
+            ));
+        }
+        if args.max_island_faces == Some(0) {
+            return Err("--max-island-faces: an island holds at least 1 face".into());
+        }
+        let flat_fold = args.flat_fold.unwrap_or(1.0);
+        if !(0.0..90.0).contains(&flat_fold) {
+            return Err(format!(
+                "--flat-fold: {flat_fold} must be an angle in degrees from 0 to below 90"
+            ));
+        }
+        let island_spread = args.island_spread.unwrap_or(2.0);
+        if !(island_spread >= 1.0 && island_spread.is_finite()) {
+            return Err(format!(
+                "--island-spread: {island_spread} must be a number of at least 1 (a convex island has 1)"
+            ));
+        }
+        Ok(Box::new(NetOptions {
+            island_spread,
+            panel,
+            tab_height: crate::units::positive_length(
+                "tab-height",
+                args.tab_height.as_deref(),
+                "8mm",
+            )?,
+            max_island_faces: args.max_island_faces,
+            flat_fold: flat_fold.to_radians(),
+        }))
+    }
+}
+
+impl Configured for NetOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        Ok(panels(mesh, self))
+    }
+
+    fn params(&self) -> Params {
+        let mut params = Params::default();
+        params.push("tab_height", round4(self.tab_height));
+        match self.max_island_faces {
+            Some(n) => params.push("max_island_faces", n),
+            None => params.push("max_island_faces", "none"),
+        }
+        params.push("flat_fold_deg", round4(self.flat_fold.to_degrees()));
+        params.push("island_spread", self.island_spread);
+        params
+    }
+}
+
+/// The angle between the normals of an interior edge's two faces (0: flat).
+fn fold_angle(mesh: &Mesh, e: EdgeId) -> Option<f64> {
+    let h = e.half_edge();
+    let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
+    Some(mesh.face_normal(f).angle_between(mesh.face_normal(g)))
+}
+
+/// A bucket grid over an island's flat faces and tabs, for overlap queries.
+struct Grid {
+    cell: f64,
+    cells: HashMap<(i64, i64), Vec<u32>>,
+}
+
+impl Grid {
+    fn new(cell: f64) -> Self {
+        Grid {
+            cell,
+            cells: HashMap::new(),
+        }
+    }
+
+    fn range(&self, poly: &[DVec2], pad: f64) -> (i64, i64, i64, i64) {
+        let (lo, hi) = crate::plane::bounds(poly.iter().copied());
+        let c = |v: f64| (v / self.cell).floor() as i64;
+        (c(lo.x - pad), c(lo.y - pad), c(hi.x + pad), c(hi.y + pad))
+    }
+
+    fn insert(&mut self, id: u32, poly: &[DVec2]) {
+        let (x0, y0, x1, y1) = self.range(poly, ISLAND_GAP);
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                self.cells.entry((x, y)).or_default().push(id);
+            }
+        }
+    }
+
+    /// Ids of everything near `poly`, each once, in increasing order.
+    fn near(&self, poly: &[DVec2]) -> Vec<u32> {
+        let (x0, y0, x1, y1) = self.range(poly, ISLAND_GAP);
+        let mut ids = Vec::new();
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                if let Some(list) = self.cells.get(&(x, y)) {
+                    ids.extend_from_slice(list);
+                }
+            }
+        }
+        ids.sort_unstable();
+        ids.dedup();
+        ids
+    }
+}
+
+/// The largest gap between two counter-clockwise convex polygons along the edge
+/// normals of either: at least their distance apart when positive, and never positive
+/// when they overlap.
+fn separation(p: &[DVec2], q: &[DVec2]) -> f64 {
+    let mut best = f64::NEG_INFINITY;
+    for (a, b) in [(p, q), (q, p)] {
+        for i in 0..a.len() {
+            let e = a[(i + 1) % a.len()] - a[i];
+            let Some(n) = DVec2::new(e.y, -e.x).try_normalize() else {
+                continue;
+            };
+            let reach = a
+                .iter()
+                .map(|&v| n.dot(v))
+                .fold(f64::NEG_INFINITY, f64::max);
+            let start = b.iter().map(|&v| n.dot(v)).fold(f64::INFINITY, f64::min);
+            best = best.max(start - reach);
+        }
+    }
+    best
+}
+
+/// Two polygons that may touch: they overlap by less than this (mm).
+const TOUCH: f64 = 1e-6;
+
+/// Least distance (mm) between a tab and a face folded to its own face at the tab's
+/// end (the two sides of a notch): clear of the files' rounding to 0.0001 mm, so the
+/// outline never touches itself there.
+const NOTCH_GAP: f64 = 0.05;
+
+/// Union-find over the corners of the faces (a corner is named by the half-edge that
+/// leaves it): corners joined by folds are one vertex of their island.
+struct Corners {
+    parent: Vec<u32>,
+}
+
+impl Corners {
+    fn new(count: usize) -> Self {
+        Corners {
+            parent: (0..count as u32).collect(),
+        }
+    }
+
+    fn find(&self, mut c: u32) -> u32 {
+        while self.parent[c as usize] != c {
+            c = self.parent[c as usize];
+        }
+        c
+    }
+
+    /// Joins two classes; the lower root stays (so roots do not depend on the order
+    /// of joining).
+    fn union(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.find(a), self.find(b));
+        let (lo, hi) = (ra.min(rb), ra.max(rb));
+        self.parent[hi as usize] = lo;
+        // Keep paths short: point the first corners straight at the root.
+        self.parent[a as usize] = lo;
+        self.parent[b as usize] = lo;
+    }
+}
+
+/// The islands as they grow: every face's corners laid flat in its island's frame.
+struct Islands {
+    /// The island of each face (an index into `faces`).
+    of_face: Vec<u32>,
+    /// Each island's faces (empty once merged into another).
+    faces: Vec<Vec<u32>>,
+    /// Flat position of each half-edge's origin in its face's island frame.
+    corner: Vec<DVec2>,
+    /// Which corners are one vertex of their island.
+    joined: Corners,
+    /// Each island's convex hull.
+    hull: Vec<Vec<DVec2>>,
+    /// Each island's area (its faces').
+    area: Vec<f64>,
+    /// Each island's faces by place.
+    grid: Vec<Grid>,
+    /// The edges folded so far.
+    fold: Vec<bool>,
+}
+
+/// Two corners laid at the same flat point (relative to the faces' size).
+fn same_point(p: DVec2, q: DVec2, scale: f64) -> bool {
+    p.distance(q) <= 1e-9 * scale
+}
+
+impl Islands {
+    /// Every face its own island, laid in its own plane.
+    fn new(mesh: &Mesh, cell: f64) -> Self {
+        let mut corner = vec![DVec2::ZERO; mesh.half_edge_count()];
+        let mut hull = Vec::with_capacity(mesh.face_count());
+        let mut grid = Vec::with_capacity(mesh.face_count());
+        for f in mesh.faces() {
+            let hs: Vec<HalfedgeId> = mesh.face_half_edges(f).collect();
+            let o = mesh.position(mesh.origin(hs[0]));
+            let x = (mesh.position(mesh.dest(hs[0])) - o).normalize();
+            let y = mesh.face_normal(f).cross(x);
+            for &h in &hs {
+                let p = mesh.position(mesh.origin(h)) - o;
+                corner[h.index()] = DVec2::new(p.dot(x), p.dot(y));
+            }
+            let poly: Vec<DVec2> = hs.iter().map(|h| corner[h.index()]).collect();
+            let mut g = Grid::new(cell);
+            g.insert(f.0, &poly);
+            grid.push(g);
+            hull.push(convex_hull(&poly));
+        }
+        let area = mesh.faces().map(|f| mesh.face_area(f)).collect();
+        Islands {
+            area,
+            of_face: (0..mesh.face_count() as u32).collect(),
+            faces: (0..mesh.face_count() as u32).map(|f| vec![f]).collect(),
+            corner,
+            joined: Corners::new(mesh.half_edge_count()),
+            hull,
+            grid,
+            fold: vec![false; mesh.edge_count()],
+        }
+    }
+
+    /// Face `f`'s flat polygon in its island's frame.
+    fn polygon(&self, mesh: &Mesh, f: FaceId) -> Vec<DVec2> {
+        mesh.face_half_edges(f)
+            .map(|h| self.corner[h.index()])
+            .collect()
+    }
+
+    /// True when face `x` has a corner joined to corner `c` (the same island vertex).
+    fn meets_at(&self, mesh: &Mesh, x: u32, c: HalfedgeId) -> bool {
+        let root = self.joined.find(c.0);
+        mesh.face_half_edges(FaceId(x))
+            .any(|h| self.joined.find(h.0) == root)
+    }
+
+    /// Joins the islands of edge `e`'s faces along it when the smaller one, turned
+    /// about the edge, keeps clear of the larger and the union fits `limit` (with room
+    /// `tab` for tabs all round). Every other edge between the two that then lies
+    /// where both its faces put it (a flat region closing up) is folded too. Returns
+    /// whether it joined them.
+    fn try_join(&mut self, mesh: &Mesh, e: EdgeId, rules: &JoinRules<'_>) -> bool {
+        let JoinRules {
+            limit,
+            most,
+            scale,
+            spread,
+            small,
+            ..
+        } = *rules;
+        let h = e.half_edge();
+        let (Some(f), Some(g)) = (mesh.face(h), mesh.face(h.twin())) else {
+            return false;
+        };
+        let (ia, ib) = (self.of_face[f.index()], self.of_face[g.index()]);
+        if ia == ib {
+            return false;
+        }
+        let (size_a, size_b) = (self.faces[ia as usize].len(), self.faces[ib as usize].len());
+        let total = size_a + size_b;
+        if most.is_some_and(|m| total > m) || size_a.min(size_b) > small {
+            return false;
+        }
+        // The larger island stays put; ties keep the lower index.
+        let big_first = (self.faces[ia as usize].len(), std::cmp::Reverse(ia))
+            >= (self.faces[ib as usize].len(), std::cmp::Reverse(ib));
+        let (ha, hb) = if big_first {
+            (h, h.twin())
+        } else {
+            (h.twin(), h)
+        };
+        let (a, b) = (
+            self.of_face[face_of(mesh, ha)],
+            self.of_face[face_of(mesh, hb)],
+        );
+        // hb runs the edge the other way: its origin sits at ha's destination.
+        let (pa, pb) = (self.corner[ha.index()], self.corner[mesh.next(ha).index()]);
+        let (qa, qb) = (self.corner[mesh.next(hb).index()], self.corner[hb.index()]);
+        let (dp, dq) = ((pb - pa).normalize(), (qb - qa).normalize());
+        let turn = DVec2::new(dq.dot(dp), dq.perp_dot(dp));
+        let moved = |x: DVec2| pa + turn.rotate(x - qa);
+
+        let mut hull: Vec<DVec2> = self.hull[a as usize].clone();
+        hull.extend(self.hull[b as usize].iter().map(|&x| moved(x)));
+        let hull = convex_hull(&hull);
+        let area = self.area[a as usize] + self.area[b as usize];
+        if crate::plane::area(&hull) > spread * area && total > 2 {
+            return false;
+        }
+        if let Some((limit, tab)) = limit {
+            // Room for a tab's depth: tabs that would still stick out are cut back.
+            let room = tab + FIT_SLACK;
+            if !fits_rotated(
+                &hull,
+                limit.rotations,
+                limit.width - room,
+                limit.height - room,
+            ) {
+                return false;
+            }
+        }
+
+        // The edges joined: this one, and every edge between the two islands whose
+        // corners land together.
+        let mut joins: Vec<HalfedgeId> = vec![hb];
+        for &y in &self.faces[b as usize] {
+            for hy in mesh.face_half_edges(FaceId(y)) {
+                if hy == hb {
+                    continue;
+                }
+                let hx = hy.twin();
+                let Some(x) = mesh.face(hx) else { continue };
+                if self.of_face[x.index()] != a {
+                    continue;
+                }
+                let lands = same_point(
+                    moved(self.corner[hy.index()]),
+                    self.corner[mesh.next(hx).index()],
+                    scale,
+                ) && same_point(
+                    moved(self.corner[mesh.next(hy).index()]),
+                    self.corner[hx.index()],
+                    scale,
+                );
+                if lands {
+                    joins.push(hy);
+                }
+            }
+        }
+        // The corner classes these joins merge, as pairs of roots (a local
+        // union-find over them says which corners become one vertex).
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for &hy in &joins {
+            let hx = hy.twin();
+            pairs.push((self.joined.find(hy.0), self.joined.find(mesh.next(hx).0)));
+            pairs.push((self.joined.find(mesh.next(hy).0), self.joined.find(hx.0)));
+        }
+        let mut local: HashMap<u32, u32> = HashMap::new();
+        fn root(local: &HashMap<u32, u32>, mut c: u32) -> u32 {
+            while let Some(&p) = local.get(&c) {
+                if p == c {
+                    break;
+                }
+                c = p;
+            }
+            c
+        }
+        for &(p, q) in &pairs {
+            let (rp, rq) = (root(&local, p), root(&local, q));
+            if rp != rq {
+                local.insert(rp.max(rq), rp.min(rq));
+            }
+        }
+        // A cut left between the two islands needs room for its tab: the two copies of
+        // its edge must open by a notch a tab fits in, or lie a low tab apart.
+        let joined_corner = |c: HalfedgeId, d: HalfedgeId| {
+            root(&local, self.joined.find(c.0)) == root(&local, self.joined.find(d.0))
+        };
+        for &y in &self.faces[b as usize] {
+            for hy in mesh.face_half_edges(FaceId(y)) {
+                let hx = hy.twin();
+                let Some(x) = mesh.face(hx) else { continue };
+                if self.of_face[x.index()] != a || joins.contains(&hy) {
+                    continue;
+                }
+                let (y0, y1) = (
+                    moved(self.corner[hy.index()]),
+                    moved(self.corner[mesh.next(hy).index()]),
+                );
+                let (x0, x1) = (self.corner[mesh.next(hx).index()], self.corner[hx.index()]);
+                // y0 and x0 are the same 3D vertex, and so are y1 and x1: a notch when
+                // one pair is one island vertex, else a slit.
+                let notch = joined_corner(hy, mesh.next(hx)) || joined_corner(mesh.next(hy), hx);
+                let need = if notch { NOTCH_GAP } else { ISLAND_GAP };
+                let poly_y: Vec<DVec2> = self
+                    .polygon(mesh, FaceId(y))
+                    .into_iter()
+                    .map(moved)
+                    .collect();
+                let poly_x = self.polygon(mesh, x);
+                // The lowest tab on either side, clear of the other side's face.
+                let fits = [(hy, (y0, y1), &poly_x), (hx, (x1, x0), &poly_y)]
+                    .into_iter()
+                    .any(|(owner, ends, other)| {
+                        let Some(options) = rules.options else {
+                            return true;
+                        };
+                        let low = tab_options(
+                            options,
+                            TAB_STEPS[TAB_STEPS.len() - 1] * options.tab_height,
+                        );
+                        let Some(tab) = make_tab(mesh, owner, &low) else {
+                            return false;
+                        };
+                        let frame = TabFrame::on(mesh, owner, ends);
+                        let obstacle = Obstacle {
+                            outline: other.as_slice().into(),
+                            need,
+                        };
+                        clear_tab(&tab, &frame, &[obstacle], options).is_some()
+                    });
+                if !fits {
+                    return false;
+                }
+            }
+        }
+        // Faces may touch where they will share a vertex.
+        let may_touch = |x: u32, y: u32| {
+            mesh.face_half_edges(FaceId(y)).any(|cy| {
+                let ry = root(&local, self.joined.find(cy.0));
+                mesh.face_half_edges(FaceId(x))
+                    .any(|cx| root(&local, self.joined.find(cx.0)) == ry)
+            })
+        };
+        let grid = &self.grid[a as usize];
+        for &y in &self.faces[b as usize] {
+            let poly: Vec<DVec2> = self
+                .polygon(mesh, FaceId(y))
+                .into_iter()
+                .map(moved)
+                .collect();
+            for x in grid.near(&poly) {
+                let need = if may_touch(x, y) { -TOUCH } else { ISLAND_GAP };
+                if separation(&self.polygon(mesh, FaceId(x)), &poly) < need {
+                    return false;
+                }
+            }
+        }
+
+        // Join: move b's corners into a's frame.
+        let moved_faces = std::mem::take(&mut self.faces[b as usize]);
+        for &y in &moved_faces {
+            for c in mesh.face_half_edges(FaceId(y)) {
+                self.corner[c.index()] = moved(self.corner[c.index()]);
+            }
+            let poly = self.polygon(mesh, FaceId(y));
+            self.grid[a as usize].insert(y, &poly);
+            self.of_face[y as usize] = a;
+        }
+        for (p, q) in pairs {
+            self.joined.union(p, q);
+        }
+        for hy in joins {
+            self.fold[hy.edge().index()] = true;
+        }
+        self.grid[b as usize] = Grid::new(1.0);
+        self.faces[a as usize].extend(moved_faces);
+        self.hull[a as usize] = hull;
+        self.hull[b as usize] = Vec::new();
+        self.area[a as usize] = area;
+        true
+    }
+}
+
+/// What a join must respect.
+#[derive(Clone, Copy)]
+struct JoinRules<'a> {
+    /// The options, for the tabs a join leaves inside an island (`None`: no tabs).
+    options: Option<&'a NetOptions>,
+    /// The largest island a sheet takes, with the room kept for a tab's depth.
+    limit: Option<(PanelLimit, f64)>,
+    /// Most faces in one island.
+    most: Option<usize>,
+    /// The model's largest edge (for "the same point").
+    scale: f64,
+    /// Largest ratio of the joined island's convex hull to its area.
+    spread: f64,
+    /// Join only when the smaller island has at most this many faces.
+    small: usize,
+}
+
+/// The face of a half-edge known to have one, as an index.
+fn face_of(mesh: &Mesh, h: HalfedgeId) -> usize {
+    mesh.face(h).map_or(0, |f| f.index())
+}
+
+/// A cut edge's tab as placed.
+struct PlacedTab {
+    tab: Tab,
+    /// Lower or narrower than wanted (by the partner face or the island's room).
+    shortened: bool,
+}
+
+/// The options for a half-edge tab of height `height`.
+fn tab_options(options: &NetOptions, height: f64) -> HalfEdgeOptions {
+    HalfEdgeOptions {
+        panel: options.panel.clone(),
+        tabs: true,
+        tab_height: height,
+    }
+}
+
+/// The map between a tab's 3D plane (the partner face's) and its island's flat frame,
+/// for a tab on half-edge `h` (a → b in its face): unfolded about the edge, the tab
+/// lies right of a → b in the flat, where its face lies left.
+struct TabFrame {
+    a: DVec3,
+    x: DVec3,
+    y: DVec3,
+    pa: DVec2,
+    dx: DVec2,
+    right: DVec2,
+}
+
+impl TabFrame {
+    fn new(mesh: &Mesh, islands: &Islands, h: HalfedgeId) -> Self {
+        let ends = (
+            islands.corner[h.index()],
+            islands.corner[mesh.next(h).index()],
+        );
+        Self::on(mesh, h, ends)
+    }
+
+    /// The frame of a tab on `h` whose edge lies flat from `pa` to `pb`.
+    fn on(mesh: &Mesh, h: HalfedgeId, (pa, pb): (DVec2, DVec2)) -> Self {
+        let a = mesh.position(mesh.origin(h));
+        let x = (mesh.position(mesh.dest(h)) - a).normalize();
+        let n_g = mesh
+            .face(h.twin())
+            .map_or(DVec3::Z, |g| mesh.face_normal(g));
+        let dx = (pb - pa).normalize();
+        TabFrame {
+            a,
+            x,
+            y: x.cross(n_g).normalize(),
+            pa,
+            dx,
+            right: DVec2::new(dx.y, -dx.x),
+        }
+    }
+
+    fn flat(&self, p: DVec3) -> DVec2 {
+        let d = p - self.a;
+        self.pa + d.dot(self.x) * self.dx + d.dot(self.y) * self.right
+    }
+
+    fn back(&self, q: DVec2) -> DVec3 {
+        let d = q - self.pa;
+        self.a + d.dot(self.dx) * self.x + d.dot(self.right) * self.y
+    }
+
+    /// Distance of a flat point from the edge's line, toward the tab.
+    fn depth(&self, q: DVec2) -> f64 {
+        (q - self.pa).dot(self.right)
+    }
+}
+
+/// A polygon already in an island, and how far a new tab must stay from it.
+struct Obstacle<'a> {
+    outline: std::borrow::Cow<'a, [DVec2]>,
+    need: f64,
+}
+
+/// `tab` cut back to keep clear of `obstacles`: each one it comes too near is cut
+/// away along that obstacle's side that leaves the most of the tab. `None` when less
+/// than half its base or under a third of its area is left. The tab's flat outline
+/// (counter-clockwise) comes with it.
+fn clear_tab(
+    tab: &Tab,
+    frame: &TabFrame,
+    obstacles: &[Obstacle],
+    options: &NetOptions,
+) -> Option<(Tab, Vec<DVec2>, bool)> {
+    // Facet order b', a', top…: counter-clockwise, face up.
+    let mut poly: Vec<DVec2> = [tab.base[1], tab.base[0]]
+        .iter()
+        .chain(&tab.top)
+        .map(|&p| frame.flat(p))
+        .collect();
+    let full_area = crate::plane::area(&poly);
+    let base_length = tab.base[0].distance(tab.base[1]);
+    let mut cut = false;
+    for obstacle in obstacles {
+        let other = &obstacle.outline;
+        if separation(other, &poly) >= obstacle.need {
+            continue;
+        }
+        // The obstacle's side beyond which most of the tab lies.
+        let side = (0..other.len())
+            .filter_map(|i| {
+                let e = other[(i + 1) % other.len()] - other[i];
+                let n = DVec2::new(e.y, -e.x).try_normalize()?;
+                let start = poly.iter().map(|&q| n.dot(q)).fold(f64::INFINITY, f64::min);
+                Some((start - n.dot(other[i]), i, n, e))
+            })
+            .max_by(|p, q| p.0.total_cmp(&q.0).then(q.1.cmp(&p.1)))?;
+        let (_, i, n, e) = side;
+        let on = other[i] + obstacle.need * n;
+        poly = crate::plane::clip_half_plane(&poly, on + e, on);
+        cut = true;
+        if poly.len() < 3 {
+            return None;
+        }
+    }
+    if !cut {
+        return Some((tab.clone(), poly, false));
+    }
+    if crate::plane::area(&poly) < full_area / 3.0 {
+        return None;
+    }
+    // The base: the points left on the edge's line, from b' (far along) to a'.
+    let scale = base_length.max(1.0);
+    let on_base = |q: DVec2| frame.depth(q).abs() <= 1e-9 * scale;
+    let along = |q: DVec2| (q - frame.pa).dot(frame.dx);
+    let base: Vec<usize> = (0..poly.len()).filter(|&k| on_base(poly[k])).collect();
+    let b_end = *base
+        .iter()
+        .max_by(|&&i, &&j| along(poly[i]).total_cmp(&along(poly[j])))?;
+    let a_end = *base
+        .iter()
+        .min_by(|&&i, &&j| along(poly[i]).total_cmp(&along(poly[j])))?;
+    if along(poly[b_end]) - along(poly[a_end]) < 0.5 * base_length {
+        return None;
+    }
+    // Counter-clockwise from a' round the top back to b'.
+    let n = poly.len();
+    let top: Vec<DVec2> = (1..n)
+        .map(|k| poly[(a_end + k) % n])
+        .take_while(|&q| !on_base(q) || q != poly[b_end])
+        .filter(|&q| !on_base(q))
+        .collect();
+    if top.is_empty() {
+        return None;
+    }
+    let outline: Vec<DVec2> = [poly[b_end], poly[a_end]]
+        .into_iter()
+        .chain(top.iter().copied())
+        .collect();
+    let clearance = 0.5 * options.panel.hole_diameter + options.panel.hole_margin;
+    let holes: Vec<DVec3> = tab
+        .holes
+        .iter()
+        .copied()
+        .filter(|&p| {
+            let q = frame.flat(p);
+            crate::plane::contains(&outline, q)
+                && crate::plane::distance_to_border(&outline, q) >= clearance
+        })
+        .collect();
+    let cleared = Tab {
+        owner: tab.owner,
+        base: [frame.back(poly[a_end]), frame.back(poly[b_end])],
+        top: top.iter().map(|&q| frame.back(q)).collect(),
+        holes_skipped: tab.holes_skipped || holes.len() < tab.holes.len(),
+        holes,
+        shortened: true,
+    };
+    Some((cleared, outline, true))
+}
+
+/// The tabs of every cut edge, by edge (`None`: no room for one). The island's hull,
+/// tabs included, must still fit `limit`.
+fn place_tabs(
+    mesh: &Mesh,
+    islands: &Islands,
+    cuts: &[EdgeId],
+    limit: Option<PanelLimit>,
+    options: &NetOptions,
+) -> Vec<Option<PlacedTab>> {
+    let mut placed: Vec<Option<PlacedTab>> = (0..mesh.edge_count()).map(|_| None).collect();
+    // Tabs already placed, per island: (owner face, flat outline); and the hulls.
+    let mut island_tabs: HashMap<u32, Vec<(u32, Vec<DVec2>)>> = HashMap::new();
+    let mut hulls: Vec<Vec<DVec2>> = islands.hull.clone();
+    for &e in cuts {
+        let h = e.half_edge();
+        // Even edges try the face of half-edge 2e first, odd ones the other.
+        let sides = if e.0.is_multiple_of(2) {
+            [h, h.twin()]
+        } else {
+            [h.twin(), h]
+        };
+        'found: for step in TAB_STEPS {
+            for owner in sides {
+                let Some(f) = mesh.face(owner) else { continue };
+                let wanted = tab_options(options, step * options.tab_height);
+                let Some(tab) = make_tab(mesh, owner, &wanted) else {
+                    continue;
+                };
+                let frame = TabFrame::new(mesh, islands, owner);
+                let island = islands.of_face[f.index()];
+                // The faces folded to this one round the tab's ends come nearest its
+                // inset base: they only have to stay clear of it.
+                let need = |x: u32| {
+                    if islands.meets_at(mesh, x, owner)
+                        || islands.meets_at(mesh, x, mesh.next(owner))
+                    {
+                        NOTCH_GAP
+                    } else {
+                        ISLAND_GAP
+                    }
+                };
+                let probe: Vec<DVec2> = [tab.base[1], tab.base[0]]
+                    .iter()
+                    .chain(&tab.top)
+                    .map(|&p| frame.flat(p))
+                    .collect();
+                let mut obstacles: Vec<Obstacle> = islands.grid[island as usize]
+                    .near(&probe)
+                    .into_iter()
+                    .filter(|&x| x != f.0)
+                    .map(|x| Obstacle {
+                        outline: islands.polygon(mesh, FaceId(x)).into(),
+                        need: need(x),
+                    })
+                    .collect();
+                // Tabs on other edges of the same face lie beyond different edges of a
+                // convex polygon: they never meet.
+                let others = island_tabs.entry(island).or_default();
+                obstacles.extend(others.iter().filter(|(face, _)| *face != f.0).map(
+                    |(face, outline)| Obstacle {
+                        outline: outline.as_slice().into(),
+                        need: need(*face),
+                    },
+                ));
+                let Some((tab, outline, cut)) = clear_tab(&tab, &frame, &obstacles, options) else {
+                    continue;
+                };
+                let mut hull = hulls[island as usize].clone();
+                hull.extend_from_slice(&outline);
+                let hull = convex_hull(&hull);
+                if let Some(limit) = limit {
+                    let room = FIT_SLACK;
+                    if !fits_rotated(
+                        &hull,
+                        limit.rotations,
+                        limit.width - room,
+                        limit.height - room,
+                    ) {
+                        continue;
+                    }
+                }
+                hulls[island as usize] = hull;
+                others.push((f.0, outline));
+                let shortened = tab.shortened || cut || step < 1.0;
+                placed[e.index()] = Some(PlacedTab { tab, shortened });
+                break 'found;
+            }
+        }
+    }
+    placed
+}
+
+/// Builds the islands of a mesh whose faces are planar and convex.
+pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    lengths.sort_by(f64::total_cmp);
+    let cell = 2.0
+        * lengths
+            .get(lengths.len() / 2)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1e-3);
+    let mut islands = Islands::new(mesh, cell);
+
+    // Flattest edges first; the sharp ones are left to be cut.
+    let mut order: Vec<(f64, EdgeId)> = mesh
+        .edges()
+        .filter_map(|e| fold_angle(mesh, e).map(|a| (a, e)))
+        .collect();
+    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1 .0.cmp(&y.1 .0)));
+    let mut rules = JoinRules {
+        options: Some(options),
+        limit: options.panel.panel_limit.map(|l| (l, options.tab_height)),
+        most: options.max_island_faces,
+        scale: lengths.last().copied().unwrap_or(1.0),
+        spread: options.island_spread,
+        small: usize::MAX,
+    };
+    for &(_, e) in &order {
+        islands.try_join(mesh, e, &rules);
+    }
+    // Then small islands join a neighbour whatever its shape.
+    rules.spread = f64::INFINITY;
+    rules.small = SMALL_ISLAND;
+    for &(_, e) in &order {
+        islands.try_join(mesh, e, &rules);
+    }
+    let cuts: Vec<EdgeId> = order
+        .iter()
+        .map(|&(_, e)| e)
+        .filter(|e| !islands.fold[e.index()])
+        .collect::<std::collections::BTreeSet<_>>()
+        .into_iter()
+        .collect();
+    let tabs = place_tabs(mesh, &islands, &cuts, options.panel.panel_limit, options);
+
+    // Islands in the order of their lowest face, numbered from 1.
+    let mut members: Vec<Vec<u32>> = islands
+        .faces
+        .iter()
+        .filter(|f| !f.is_empty())
+        .map(|f| {
+            let mut f = f.clone();
+            f.sort_unstable();
+            f
+        })
+        .collect();
+    members.sort();
+    let mut number = vec![0u32; mesh.face_count()];
+    let mut facet_of = vec![0u32; mesh.face_count()];
+    for (k, faces) in members.iter().enumerate() {
+        for (i, &f) in faces.iter().enumerate() {
+            number[f as usize] = k as u32 + 1;
+            facet_of[f as usize] = i as u32;
+        }
+    }
+    let match_of: HashMap<u32, u32> = cuts
+        .iter()
+        .enumerate()
+        .map(|(k, e)| (e.0, k as u32 + 1))
+        .collect();
+
+    let built: Vec<Panel> = members
+        .iter()
+        .enumerate()
+        .map(|(k, faces)| {
+            island_panel(
+                mesh,
+                k as u32 + 1,
+                faces,
+                &islands,
+                &tabs,
+                &match_of,
+                &facet_of,
+                options,
+            )
+        })
+        .collect();
+    let panels: Panels = built.into_iter().collect();
+
+    let tab_count = tabs.iter().flatten().count();
+    let shortened = tabs.iter().flatten().filter(|t| t.shortened).count();
+    let mut notes = Vec::new();
+    if tab_count < cuts.len() {
+        notes.push(format!(
+            "{} of {} cut edges have no tab: no room for one beside their island's other faces (glue them edge to edge, or try a smaller --tab-height)",
+            cuts.len() - tab_count,
+            cuts.len()
+        ));
+    }
+    if shortened > 0 {
+        notes.push(format!(
+            "{shortened} tabs were shortened to stay inside their neighbour face and clear of their island"
+        ));
+    }
+    let unfastened: Vec<ConnectionName> = if options.panel.holes == 0 {
+        Vec::new()
+    } else {
+        cuts.iter()
+            .filter(|e| {
+                tabs[e.index()]
+                    .as_ref()
+                    .is_none_or(|t| t.tab.holes.is_empty())
+            })
+            .filter_map(|&e| {
+                let h = e.half_edge();
+                let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
+                Some(ConnectionName {
+                    panels: [
+                        Name::Island(number[f.index()]),
+                        Name::Island(number[g.index()]),
+                    ],
+                    at: Name::Edge(e.0),
+                })
+            })
+            .collect()
+    };
+
+    let summary = Summary::of(
+        mesh, &islands, &members, &cuts, tab_count, shortened, options,
+    );
+    SchemeOutput {
+        panels,
+        connections: cuts.len(),
+        notes,
+        report: summary.report(),
+        manifest: summary.manifest(),
+        unfastened,
+        islands: members,
+        flat_fold: Some(options.flat_fold),
+    }
+}
+
+/// Builds island `number`'s panel: its faces (facets in face order, corners shared
+/// along folds), then the tabs its faces own; the island id on a central face, match
+/// numbers at every cut edge on both sides.
+#[allow(clippy::too_many_arguments)]
+fn island_panel(
+    mesh: &Mesh,
+    number: u32,
+    faces: &[u32],
+    islands: &Islands,
+    tabs: &[Option<PlacedTab>],
+    match_of: &HashMap<u32, u32>,
+    facet_of: &[u32],
+    options: &NetOptions,
+) -> Panel {
+    let height = options.panel.label_height;
+    // One vertex per fan of corners joined by folds.
+    let mut vertex_of: HashMap<u32, u32> = HashMap::new();
+    let mut vertices: Vec<DVec3> = Vec::new();
+    let mut corner_vertex = |h: HalfedgeId, vertices: &mut Vec<DVec3>| -> u32 {
+        let key = islands.joined.find(h.0);
+        *vertex_of.entry(key).or_insert_with(|| {
+            vertices.push(mesh.position(mesh.origin(h)));
+            (vertices.len() - 1) as u32
+        })
+    };
+    let mut facets = Loops::new();
+    let mut tab_facets: Vec<(EdgeId, u32, u32)> = Vec::new();
+    let mut labels = Vec::new();
+    let mut holes = Vec::new();
+    for &f in faces {
+        let f = FaceId(f);
+        let mut facet = Vec::new();
+        for h in mesh.face_half_edges(f) {
+            facet.push(corner_vertex(h, &mut vertices));
+            let e = h.edge();
+            if let Some(placed) = tabs[e.index()].as_ref().filter(|t| t.tab.owner == h) {
+                vertices.push(placed.tab.base[0]);
+                vertices.push(placed.tab.base[1]);
+                let n = vertices.len() as u32;
+                facet.push(n - 2);
+                facet.push(n - 1);
+                tab_facets.push((e, n - 2, n - 1));
+            }
+            // The match number inside this face at a cut edge, unless its tab carries it.
+            if let Some(&m) = match_of.get(&e.0) {
+                let owns_tab = tabs[e.index()].as_ref().is_some_and(|t| t.tab.owner == h);
+                if !owns_tab {
+                    let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
+                    labels.push(Label {
+                        text: Name::Match(m),
+                        anchor: 0.5 * (a + b),
+                        direction: (b - a).normalize(),
+                        height,
+                        facet: facet_of[f.index()],
+                        kind: LabelKind::Partner,
+                        on_edge: true,
+                        slide: 0.3 * a.distance(b),
+                    });
+                }
+            }
+        }
+        facets.push(facet);
+    }
+    for (e, a_base, b_base) in tab_facets {
+        let Some(placed) = tabs[e.index()].as_ref() else {
+            continue;
+        };
+        let facet_index = facets.len() as u32;
+        let mut facet = vec![b_base, a_base];
+        for &p in &placed.tab.top {
+            vertices.push(p);
+            facet.push((vertices.len() - 1) as u32);
+        }
+        facets.push(facet);
+        let (a, b) = (placed.tab.base[0], placed.tab.base[1]);
+        labels.push(Label {
+            text: Name::Match(match_of[&e.0]),
+            anchor: 0.5 * (a + b),
+            direction: (a - b).normalize(),
+            height,
+            facet: facet_index,
+            kind: LabelKind::Partner,
+            on_edge: true,
+            slide: 0.2 * a.distance(b),
+        });
+        for &p in &placed.tab.holes {
+            holes.push(Hole {
+                position: p,
+                diameter: options.panel.hole_diameter,
+                connection: e.0,
+                facet: facet_index,
+            });
+        }
+    }
+    // Holes of tabs other islands (or this one) fold onto these faces.
+    for &f in faces {
+        for h in mesh.face_half_edges(FaceId(f)) {
+            if let Some(placed) = tabs[h.edge().index()]
+                .as_ref()
+                .filter(|t| t.tab.owner == h.twin())
+            {
+                for &p in &placed.tab.holes {
+                    holes.push(Hole {
+                        position: p,
+                        diameter: options.panel.hole_diameter,
+                        connection: h.edge().0,
+                        facet: facet_of[f as usize],
+                    });
+                }
+            }
+        }
+    }
+    // The island id on the largest face near the island's middle.
+    let label_face = central_face(mesh, islands, faces);
+    let corners: Vec<DVec3> = mesh.face_positions(FaceId(label_face)).collect();
+    let longest = (0..corners.len())
+        .max_by(|&i, &j| {
+            let li = corners[i].distance(corners[(i + 1) % corners.len()]);
+            let lj = corners[j].distance(corners[(j + 1) % corners.len()]);
+            li.total_cmp(&lj).then(j.cmp(&i))
+        })
+        .unwrap_or(0);
+    labels.push(Label {
+        text: Name::Island(number),
+        anchor: mesh.face_centre(FaceId(label_face)),
+        direction: (corners[(longest + 1) % corners.len()] - corners[longest]).normalize(),
+        height,
+        facet: facet_of[label_face as usize],
+        kind: LabelKind::Panel,
+        on_edge: false,
+        slide: 0.0,
+    });
+    Panel::new(Source::Island(number), vertices, facets, holes, labels)
+}
+
+/// The face that shows an island's id: the largest among those whose centre lies in
+/// the inner half of the island (flat), or the largest of all when none does.
+fn central_face(mesh: &Mesh, islands: &Islands, faces: &[u32]) -> u32 {
+    let centre_of = |f: u32| {
+        let poly = islands.polygon(mesh, FaceId(f));
+        poly.iter().copied().sum::<DVec2>() / poly.len() as f64
+    };
+    let middle = faces.iter().map(|&f| centre_of(f)).sum::<DVec2>() / faces.len() as f64;
+    let reach = faces
+        .iter()
+        .map(|&f| centre_of(f).distance(middle))
+        .fold(0.0, f64::max);
+    let largest = |pool: &mut dyn Iterator<Item = u32>| {
+        pool.max_by(|&x, &y| {
+            mesh.face_area(FaceId(x))
+                .total_cmp(&mesh.face_area(FaceId(y)))
+                .then(y.cmp(&x))
+        })
+    };
+    largest(
+        &mut faces
+            .iter()
+            .copied()
+            .filter(|&f| centre_of(f).distance(middle) <= 0.5 * reach),
+    )
+    .or_else(|| largest(&mut faces.iter().copied()))
+    .unwrap_or(faces[0])
+}
+
+/// What the report and the manifest say of the islands.
+struct Summary {
+    islands: usize,
+    largest: usize,
+    median: usize,
+    folds: [usize; 3],
+    fold_length: f64,
+    cuts: usize,
+    cut_length: f64,
+    tabs: usize,
+    shortened: usize,
+}
+
+impl Summary {
+    fn of(
+        mesh: &Mesh,
+        islands: &Islands,
+        members: &[Vec<u32>],
+        cuts: &[EdgeId],
+        tabs: usize,
+        shortened: usize,
+        options: &NetOptions,
+    ) -> Summary {
+        let mut sizes: Vec<usize> = members.iter().map(Vec::len).collect();
+        sizes.sort_unstable();
+        // Mountain, valley, flat (not scored).
+        let mut folds = [0usize; 3];
+        let mut fold_length = 0.0;
+        for e in mesh.edges().filter(|e| islands.fold[e.index()]) {
+            fold_length += mesh.edge_length(e);
+            let h = e.half_edge();
+            let (Some(f), Some(g)) = (mesh.face(h), mesh.face(h.twin())) else {
+                continue;
+            };
+            let (nf, ng) = (mesh.face_normal(f), mesh.face_normal(g));
+            let along = mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h));
+            let kind = if nf.angle_between(ng) < options.flat_fold {
+                2
+            } else if nf.cross(ng).dot(along) > 0.0 {
+                0
+            } else {
+                1
+            };
+            folds[kind] += 1;
+        }
+        Summary {
+            islands: members.len(),
+            largest: sizes.last().copied().unwrap_or(0),
+            median: sizes.get(sizes.len() / 2).copied().unwrap_or(0),
+            folds,
+            fold_length,
+            cuts: cuts.len(),
+            cut_length: cuts.iter().map(|&e| mesh.edge_length(e)).sum(),
+            tabs,
+            shortened,
+        }
+    }
+
+    fn report(&self) -> Vec<String> {
+        vec![format!(
+            "net: {} islands (largest {} faces, median {}); folds {} mountain, {} valley, {} too flat to score, {} in all; {} cut edges, {} in all, with {} tabs",
+            self.islands,
+            self.largest,
+            self.median,
+            self.folds[0],
+            self.folds[1],
+            self.folds[2],
+            metres(self.fold_length),
+            self.cuts,
+            metres(self.cut_length),
+            self.tabs
+        )]
+    }
+
+    fn manifest(&self) -> Params {
+        let mut params = Params::default();
+        params.push(
+            "net",
+            serde_json::json!({
+                "islands": self.islands,
+                "largest_island_faces": self.largest,
+                "median_island_faces": self.median,
+                "folds_mountain": self.folds[0],
+                "folds_valley": self.folds[1],
+                "folds_flat": self.folds[2],
+                "fold_length": round4(self.fold_length),
+                "cuts": self.cuts,
+                "cut_length": round4(self.cut_length),
+                "tabs": self.tabs,
+                "tabs_shortened": self.shortened,
+            }),
+        );
+        params
+    }
+}
+
+/// A length in metres with one decimal (mm below a metre), for the report.
+fn metres(mm: f64) -> String {
+    let mm = mm.max(0.0);
+    if mm < 1000.0 {
+        format!("{mm:.0} mm")
+    } else {
+        format!("{:.1} m", mm / 1000.0)
+    }
+}
