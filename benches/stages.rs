@@ -9,7 +9,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use glam::DVec2;
 
 use unfold::config::{BuildOptions, Job, ModelOptions};
-use unfold::export::{draw_sheet, svg};
+use unfold::export::{draw_sheet, svg, Layers, PathOrder};
 use unfold::flatten::unroll_and_fit;
 use unfold::labels::LabelOptions;
 use unfold::mesh::Mesh;
@@ -139,9 +139,9 @@ fn nesting_and_export(c: &mut Criterion) {
     for (name, layout, panels, sheet) in &drawn {
         group.bench_function(name.as_str(), |b| {
             b.iter(|| {
-                let mut sink =
-                    svg::SvgSheet::new(sheet.width, sheet.height, svg::SvgStyle::default());
-                draw_sheet(layout, 0, panels, &mut sink);
+                let layers = Layers::standard(0.0254);
+                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, &layers);
+                draw_sheet(layout, 0, panels, false, PathOrder::Shortest, &mut sink);
                 sink.finish()
             })
         });

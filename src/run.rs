@@ -14,7 +14,7 @@ use crate::config::{Job, NonPlanar};
 use crate::error::{Error, InputError, Result};
 use crate::export::folder::{check_output_folder, MANIFEST};
 use crate::export::manifest::{self, round4, Manifest};
-use crate::export::{draw_sheet, obj::assembled_obj, Lengths};
+use crate::export::{draw_sheet, obj::assembled_obj, Lengths, PathOrder};
 use crate::flatten::unroll_all;
 use crate::labels::{LabelOptions, LeftOut};
 use crate::mesh::planarize::{planarize, PlanarizeOptions, PlanarizeReport};
@@ -45,6 +45,8 @@ pub struct Outcome {
 struct DrawnSheet {
     files: Vec<(String, Vec<u8>)>,
     lengths: Lengths,
+    /// Travel with the paths as placed, for the travel the order saves.
+    travel_as_placed: f64,
     entry: manifest::SheetEntry,
 }
 
@@ -387,12 +389,28 @@ pub fn export(
                 .map(|format| {
                     (
                         format!("{stem}.{}", format.extension()),
-                        format.write_sheet(layout, index, panels, job.stroke_width),
+                        format.write_sheet(layout, index, panels, &job.style),
                     )
                 })
                 .collect();
             let mut lengths = Lengths::default();
-            draw_sheet(layout, index, panels, &mut lengths);
+            draw_sheet(
+                layout,
+                index,
+                panels,
+                false,
+                PathOrder::Shortest,
+                &mut lengths,
+            );
+            let mut as_placed = Lengths::default();
+            draw_sheet(
+                layout,
+                index,
+                panels,
+                false,
+                PathOrder::AsPlaced,
+                &mut as_placed,
+            );
             let on_sheet: Vec<FlatPanelRef> = layout
                 .placements
                 .iter()
@@ -405,27 +423,47 @@ pub fn export(
                 files: sheet_files.iter().map(|(n, _)| n.clone()).collect(),
                 panels: on_sheet.len(),
                 fill: round4(area / (sheet.width * sheet.height)),
+                lengths: manifest::Lengths::of(&lengths),
+                time_s: round4(job.speeds.seconds(&lengths)),
             };
             DrawnSheet {
                 files: sheet_files,
                 lengths,
+                travel_as_placed: as_placed.travel,
                 entry,
             }
         })
         .collect();
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
     let mut lengths = Lengths::default();
+    let mut travel_as_placed = 0.0;
     let mut sheet_entries = Vec::new();
     for sheet in drawn {
         files.extend(sheet.files);
         // Summed in sheet order, so the totals do not depend on the thread count.
-        lengths.cut += sheet.lengths.cut;
-        lengths.score += sheet.lengths.score;
-        lengths.score_valley += sheet.lengths.score_valley;
-        lengths.engrave += sheet.lengths.engrave;
+        lengths.add(&sheet.lengths);
+        travel_as_placed += sheet.travel_as_placed;
         sheet_entries.push(sheet.entry);
     }
-    let mut manifest = build_manifest(job, prepared, output, flat, nested, lengths, sheet_entries);
+    let laser = manifest::Laser {
+        speeds: manifest::Speeds {
+            cut: job.speeds.cut,
+            score: job.speeds.score,
+            engrave: job.speeds.engrave,
+            travel: job.speeds.travel,
+        },
+        time_s: round4(job.speeds.seconds(&lengths)),
+        travel_as_placed: round4(travel_as_placed),
+    };
+    let mut manifest = build_manifest(
+        job,
+        prepared,
+        output,
+        flat,
+        nested,
+        (lengths, laser),
+        sheet_entries,
+    );
     files.push((
         format!("{name}-assembled.obj"),
         assembled_obj(&output.panels).into_bytes(),
@@ -528,7 +566,7 @@ fn build_manifest(
     output: &SchemeOutput,
     flat: &Flat,
     nested: &Nested,
-    lengths: Lengths,
+    (lengths, laser): (Lengths, manifest::Laser),
     sheets: Vec<manifest::SheetEntry>,
 ) -> Manifest {
     let SchemeMesh {
@@ -600,12 +638,8 @@ fn build_manifest(
         nesting: nested.nesting.clone(),
         panel_area: round4(panel_area),
         utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
-        lengths: manifest::Lengths {
-            cut: round4(lengths.cut),
-            score: round4(lengths.score),
-            score_valley: round4(lengths.score_valley),
-            engrave: round4(lengths.engrave),
-        },
+        lengths: manifest::Lengths::of(&lengths),
+        laser,
         scheme_sections: output.manifest.clone(),
         max_developability_error: manifest::round_nm(
             flat.iter()

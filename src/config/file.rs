@@ -10,7 +10,7 @@ use std::path::Path;
 
 use toml::de::{DeTable, DeValue};
 
-use super::{parse_length, parse_sheet, BuildOptions, ModelOptions};
+use super::{parse_length, parse_sheet, BuildOptions, LayerSettings, ModelOptions};
 use crate::error::{Error, Result};
 use crate::scheme::{OptionValues, Registry};
 
@@ -45,8 +45,13 @@ pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
     // In file order, so the first mistake reported is the first in the file.
     let mut entries: Vec<_> = table.get_ref().iter().collect();
     entries.sort_by_key(|(key, _)| key.span().start);
+    let mut layers = LayerSettings::default();
     for (key, value) in entries {
         let name = key.get_ref().as_ref();
+        if name == "layers" {
+            read_layers(value, &mut layers).map_err(|(span, why)| at(Some(span), why))?;
+            continue;
+        }
         let Some(option) = options.iter().find(|o| o.key == name) else {
             return Err(at(Some(key.span()), unknown_key(name, &options)));
         };
@@ -75,8 +80,76 @@ pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
     Ok(BuildOptions {
         model,
         scheme_values,
+        layers,
         ..build
     })
+}
+
+/// A place in the file and what is wrong there.
+type Mistake = (Range<usize>, String);
+
+/// Reads the `[layers.KIND]` tables: each kind's `name`, `color` and `stroke-width`.
+fn read_layers(
+    value: &toml::Spanned<DeValue>,
+    layers: &mut LayerSettings,
+) -> std::result::Result<(), Mistake> {
+    let kinds = LayerSettings::KEYS.join(", ");
+    let DeValue::Table(table) = value.get_ref() else {
+        return Err((
+            value.span(),
+            format!(
+                "layers is a table of kinds ({kinds}): write [layers.cut] and its keys below it"
+            ),
+        ));
+    };
+    for (kind, fields) in table.iter() {
+        let kind_name = kind.get_ref().as_ref();
+        let Some(k) = LayerSettings::KEYS.iter().position(|&n| n == kind_name) else {
+            return Err((
+                kind.span(),
+                format!("layers.{kind_name}: not a kind of laser geometry; the kinds are {kinds}"),
+            ));
+        };
+        let DeValue::Table(fields) = fields.get_ref() else {
+            return Err((
+                fields.span(),
+                format!("layers.{kind_name} is a table: write [layers.{kind_name}] with name, color or stroke-width below it"),
+            ));
+        };
+        for (field, text) in fields.iter() {
+            let field_name = field.get_ref().as_ref();
+            let place = format!("layers.{kind_name}.{field_name}");
+            let DeValue::String(text_value) = text.get_ref() else {
+                return Err((
+                    text.span(),
+                    format!(
+                        "{place}: text in quotes, like {field_name} = \"{}\"",
+                        match field_name {
+                            "color" => "#FF0000",
+                            "stroke-width" => "0.001in",
+                            _ => "CUT",
+                        }
+                    ),
+                ));
+            };
+            let text_value = text_value.to_string();
+            let setting = &mut layers.0[k];
+            let checked = match field_name {
+                "name" => {
+                    super::check_layer_name(&text_value).map(|()| setting.name = Some(text_value))
+                }
+                "color" => super::check_layer_color(&text_value).map(|c| setting.color = Some(c)),
+                "stroke-width" => {
+                    parse_length(&text_value).map(|_| setting.stroke_width = Some(text_value))
+                }
+                _ => Err(
+                    "not a layer setting; a layer takes name, color and stroke-width".to_string(),
+                ),
+            };
+            checked.map_err(|why| (field.span(), format!("{place}: {why}")))?;
+        }
+    }
+    Ok(())
 }
 
 /// What values an option takes.

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 
 use crate::error::{Error, Result};
-use crate::export::Format;
+use crate::export::laser::Speeds;
+use crate::export::{Format, Kind, Layers, SheetStyle};
 use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry};
 
 mod file;
@@ -375,6 +376,16 @@ pub struct BuildOptions {
     #[serde(default)]
     pub no_map: bool,
 
+    /// The face the labels read on: outside, or inside (mirrored, for models assembled
+    /// inside out or cut face down). [default: outside]
+    #[arg(long, value_name = "SIDE")]
+    pub labels: Option<LabelSide>,
+
+    /// Laser speeds in mm/s for the time estimate: any of cut, score, engrave and
+    /// travel (beam off). [default: cut=15,score=50,engrave=100,travel=300]
+    #[arg(long, value_name = "LIST")]
+    pub speeds: Option<String>,
+
     /// Output formats, comma separated: svg, dxf. [default: svg]
     #[arg(long, value_name = "LIST")]
     pub format: Option<String>,
@@ -476,6 +487,114 @@ pub struct BuildOptions {
     #[arg(skip)]
     #[serde(skip)]
     pub scheme_values: OptionValues,
+
+    /// Layer names, colours and stroke widths per kind (config file only: the
+    /// `[layers.cut]` tables).
+    #[arg(skip)]
+    #[serde(skip)]
+    pub layers: LayerSettings,
+}
+
+/// The face labels read on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum LabelSide {
+    /// The outside of the model (the side facing up on the sheet).
+    Outside,
+    /// The inside: labels mirrored.
+    Inside,
+}
+
+/// One kind's layer as a config file gives it (`[layers.score-valley]`), each field
+/// optional.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LayerSetting {
+    /// Layer name.
+    pub name: Option<String>,
+    /// Colour, `#RRGGBB`.
+    pub color: Option<String>,
+    /// Stroke width, a length with a unit.
+    pub stroke_width: Option<String>,
+}
+
+/// Every kind's layer settings, in [`Kind::ALL`] order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LayerSettings(pub [LayerSetting; 4]);
+
+impl LayerSettings {
+    /// The config keys of the kinds, in [`Kind::ALL`] order.
+    pub const KEYS: [&'static str; 4] = ["engrave", "score", "score-valley", "cut"];
+
+    /// These settings, with `other`'s where a field is missing.
+    fn or(self, other: LayerSettings) -> LayerSettings {
+        let LayerSettings(mut mine) = self;
+        for (m, o) in mine.iter_mut().zip(other.0) {
+            m.name = m.name.take().or(o.name);
+            m.color = m.color.take().or(o.color);
+            m.stroke_width = m.stroke_width.take().or(o.stroke_width);
+        }
+        LayerSettings(mine)
+    }
+
+    /// The layers drawn: LASER.md's, every stroke `stroke_width` mm, with these
+    /// settings applied.
+    fn resolve(&self, stroke_width: f64) -> Result<Layers> {
+        let mut layers = Layers::standard(stroke_width);
+        for ((setting, kind), key) in self.0.iter().zip(Kind::ALL).zip(Self::KEYS) {
+            let style = layers.of_mut(kind);
+            if let Some(name) = &setting.name {
+                check_layer_name(name)
+                    .map_err(|why| Error::Usage(format!("layers.{key}.name: {why}")))?;
+                style.name = name.clone();
+            }
+            if let Some(color) = &setting.color {
+                style.color = check_layer_color(color)
+                    .map_err(|why| Error::Usage(format!("layers.{key}.color: {why}")))?;
+            }
+            if let Some(width) = &setting.stroke_width {
+                style.stroke_width = parse_length(width)
+                    .map_err(|why| Error::Usage(format!("layers.{key}.stroke-width: {why}")))?;
+            }
+        }
+        for (i, a) in layers.0.iter().enumerate() {
+            if layers.0[..i].iter().any(|b| b.name == a.name) {
+                return Err(Error::Usage(format!(
+                    "layers: two kinds are both named {}; give each kind its own layer name",
+                    a.name
+                )));
+            }
+        }
+        Ok(layers)
+    }
+}
+
+/// Says why `name` cannot be a layer name (DXF R12: letters, digits, `-`, `_`, `$`, at
+/// most 31).
+pub fn check_layer_name(name: &str) -> std::result::Result<(), String> {
+    let fine = !name.is_empty()
+        && name.len() <= 31
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '$'));
+    if fine {
+        Ok(())
+    } else {
+        Err(format!(
+            "\"{name}\" is not a layer name DXF R12 takes: use 1 to 31 letters, digits, -, _ or $, like \"CUT\""
+        ))
+    }
+}
+
+/// The colour `text` names, as `#RRGGBB` in capitals, or why it names none.
+pub fn check_layer_color(text: &str) -> std::result::Result<String, String> {
+    let hex = text.strip_prefix('#').unwrap_or("");
+    if hex.len() == 6 && hex.chars().all(|c| c.is_ascii_hexdigit()) {
+        Ok(format!("#{}", hex.to_ascii_uppercase()))
+    } else {
+        Err(format!(
+            "\"{text}\" is not a colour: write it as pure RGB, like \"#FF0000\" (drivers match colours exactly)"
+        ))
+    }
 }
 
 /// What to do with non-planar faces.
@@ -523,8 +642,10 @@ pub struct Job {
     pub nonplanar: NonPlanar,
     /// Layout settings.
     pub nest: NestSettings,
-    /// SVG stroke width (mm).
-    pub stroke_width: f64,
+    /// How the sheets are drawn: layers, and the face labels read on.
+    pub style: SheetStyle,
+    /// Laser speeds for the time estimate.
+    pub speeds: Speeds,
 }
 
 impl BuildOptions {
@@ -615,6 +736,9 @@ impl BuildOptions {
             quiet: self.quiet || other.quiet,
             model: self.model.or(other.model),
             scheme_values: self.scheme_values.or(other.scheme_values),
+            labels: self.labels.or(other.labels),
+            speeds: self.speeds.or(other.speeds),
+            layers: self.layers.or(other.layers),
         }
     }
 
@@ -783,7 +907,18 @@ impl BuildOptions {
         Ok(Job {
             nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
             nest,
-            stroke_width: length("stroke-width", &self.stroke_width, "0.001in")?,
+            style: SheetStyle {
+                layers: self.layers.resolve(length(
+                    "stroke-width",
+                    &self.stroke_width,
+                    "0.001in",
+                )?)?,
+                labels_inside: self.labels == Some(LabelSide::Inside),
+            },
+            speeds: match &self.speeds {
+                Some(text) => Speeds::parse(text).map_err(Error::Usage)?,
+                None => Speeds::default(),
+            },
             model_path: model_path.to_path_buf(),
             model: self.model.resolve()?,
             scheme,

@@ -8,32 +8,24 @@ use std::fmt::Write;
 
 use glam::DVec2;
 
-use super::{fmt_mm, Kind, SheetSink};
-
-/// AutoCAD colour index per kind.
-fn colour(kind: Kind) -> u8 {
-    match kind {
-        Kind::Cut => 1,
-        Kind::Score => 5,
-        Kind::ScoreValley => 3,
-        Kind::Engrave => 7,
-    }
-}
+use super::{fmt_mm, Kind, Layers, SheetSink};
 
 /// Collects one sheet's entities; [`DxfSheet::finish`] writes the file.
 pub struct DxfSheet {
     width: f64,
     height: f64,
     entities: [String; 4],
+    layers: Layers,
 }
 
 impl DxfSheet {
     /// A sheet of `width` × `height` mm.
-    pub fn new(width: f64, height: f64) -> Self {
+    pub fn new(width: f64, height: f64, layers: &Layers) -> Self {
         Self {
             width,
             height,
             entities: Default::default(),
+            layers: layers.clone(),
         }
     }
 
@@ -78,9 +70,9 @@ impl DxfSheet {
         pair(70, &Kind::ALL.len().to_string());
         for kind in [Kind::Cut, Kind::Score, Kind::ScoreValley, Kind::Engrave] {
             pair(0, "LAYER");
-            pair(2, kind.layer());
+            pair(2, &self.layers.of(kind).name);
             pair(70, "0");
-            pair(62, &colour(kind).to_string());
+            pair(62, &self.layers.aci(kind).to_string());
             pair(6, "CONTINUOUS");
         }
         pair(0, "ENDTAB");
@@ -115,8 +107,9 @@ impl SheetSink for DxfSheet {
         if points.len() < 2 {
             return;
         }
-        let layer = kind.layer();
-        let c = colour(kind).to_string();
+        let layer = self.layers.of(kind).name.clone();
+        let layer = layer.as_str();
+        let c = self.layers.aci(kind).to_string();
         let mut s = String::new();
         push(&mut s, 0, "POLYLINE");
         push(&mut s, 8, layer);
@@ -142,8 +135,8 @@ impl SheetSink for DxfSheet {
     fn circle(&mut self, kind: Kind, center: DVec2, radius: f64) {
         let mut s = String::new();
         push(&mut s, 0, "CIRCLE");
-        push(&mut s, 8, kind.layer());
-        push(&mut s, 62, &colour(kind).to_string());
+        push(&mut s, 8, &self.layers.of(kind).name);
+        push(&mut s, 62, &self.layers.aci(kind).to_string());
         push(&mut s, 10, &fmt_mm(center.x));
         push(&mut s, 20, &fmt_mm(center.y));
         push(&mut s, 30, "0");

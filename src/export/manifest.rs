@@ -149,6 +149,46 @@ pub struct Lengths {
     pub score_valley: f64,
     /// Engrave.
     pub engrave: f64,
+    /// Travel with the beam off, paths in the order the files give them.
+    pub travel: f64,
+}
+
+impl Lengths {
+    /// The manifest's record of measured lengths, rounded.
+    pub fn of(lengths: &super::Lengths) -> Lengths {
+        Lengths {
+            cut: round4(lengths.cut),
+            score: round4(lengths.score),
+            score_valley: round4(lengths.score_valley),
+            engrave: round4(lengths.engrave),
+            travel: round4(lengths.travel),
+        }
+    }
+}
+
+/// The laser time estimate.
+#[derive(Clone, Debug, Serialize)]
+pub struct Laser {
+    /// Speeds used (mm/s).
+    pub speeds: Speeds,
+    /// Estimated time of every sheet together (seconds).
+    pub time_s: f64,
+    /// Travel of every sheet with the paths part by part as placed, for comparison
+    /// with `lengths.travel` (mm).
+    pub travel_as_placed: f64,
+}
+
+/// Laser speeds (mm/s).
+#[derive(Clone, Debug, Serialize)]
+pub struct Speeds {
+    /// Cut.
+    pub cut: f64,
+    /// Score (both fold kinds).
+    pub score: f64,
+    /// Engrave.
+    pub engrave: f64,
+    /// Travel, beam off.
+    pub travel: f64,
 }
 
 /// One output sheet.
@@ -162,6 +202,10 @@ pub struct SheetEntry {
     pub panels: usize,
     /// Panel area / sheet area.
     pub fill: f64,
+    /// Its laser path lengths.
+    pub lengths: Lengths,
+    /// Its estimated laser time (seconds).
+    pub time_s: f64,
 }
 
 /// Where a panel came from (`{"face": 12}`).
@@ -245,6 +289,8 @@ pub struct Manifest {
     pub utilization: f64,
     /// Laser path lengths.
     pub lengths: Lengths,
+    /// The laser time estimate.
+    pub laser: Laser,
     /// Largest developability error of any panel (mm).
     pub max_developability_error: f64,
     /// Warnings about the build's size (a forgotten --size, panels too small for

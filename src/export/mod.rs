@@ -5,6 +5,7 @@
 
 pub mod dxf;
 pub mod folder;
+pub mod laser;
 pub mod manifest;
 pub mod map;
 pub mod obj;
@@ -15,7 +16,7 @@ use glam::DVec2;
 
 use crate::font::text_strokes;
 use crate::nest::{Layout, Placement};
-use crate::panel::{label_box, label_extent, FlatPanelRef, FlatPanels, Fold, FoldKind};
+use crate::panel::{label_box, label_extent, FlatPanelRef, FlatPanels, FoldKind};
 
 /// The kinds of laser geometry, in the order a sheet is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -53,6 +54,98 @@ impl Kind {
             (FoldKind::Valley, false) | (FoldKind::Mountain, true) => Kind::ScoreValley,
         }
     }
+}
+
+/// How one kind of geometry is drawn: its layer's name (SVG group label, DXF layer),
+/// its colour and its stroke width.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerStyle {
+    /// Layer name.
+    pub name: String,
+    /// Pure RGB colour, `#RRGGBB` (drivers match colours exactly).
+    pub color: String,
+    /// SVG stroke width (mm).
+    pub stroke_width: f64,
+}
+
+/// The style of every kind, in [`Kind::ALL`] order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layers(pub [LayerStyle; 4]);
+
+impl Layers {
+    /// LASER.md's layers (ENGRAVE black, SCORE blue, SCORE-VALLEY green, CUT red),
+    /// every stroke `stroke_width` mm wide.
+    pub fn standard(stroke_width: f64) -> Layers {
+        Layers(Kind::ALL.map(|kind| {
+            LayerStyle {
+                name: kind.layer().to_string(),
+                color: match kind {
+                    Kind::Engrave => "#000000",
+                    Kind::Score => "#0000FF",
+                    Kind::ScoreValley => "#00FF00",
+                    Kind::Cut => "#FF0000",
+                }
+                .to_string(),
+                stroke_width,
+            }
+        }))
+    }
+
+    /// The style of `kind`.
+    pub fn of(&self, kind: Kind) -> &LayerStyle {
+        &self.0[kind as usize]
+    }
+
+    /// The style of `kind`, to change.
+    pub fn of_mut(&mut self, kind: Kind) -> &mut LayerStyle {
+        &mut self.0[kind as usize]
+    }
+
+    /// The AutoCAD colour index of `kind` in a DXF file: the nearest of the seven
+    /// standard colours to its RGB colour (R12 files have no true colour).
+    pub fn aci(&self, kind: Kind) -> u8 {
+        nearest_aci(&self.of(kind).color)
+    }
+}
+
+/// The nearest of ACI colours 1 to 7 (red, yellow, green, cyan, blue, magenta, and 7,
+/// black or white by the background) to `#RRGGBB`; 7 for anything unreadable.
+pub fn nearest_aci(color: &str) -> u8 {
+    let channel = |k: usize| {
+        color
+            .get(1 + 2 * k..3 + 2 * k)
+            .and_then(|h| u8::from_str_radix(h, 16).ok())
+            .map(f64::from)
+    };
+    let (Some(r), Some(g), Some(b)) = (channel(0), channel(1), channel(2)) else {
+        return 7;
+    };
+    let standard: [(u8, [f64; 3]); 8] = [
+        (1, [255.0, 0.0, 0.0]),
+        (2, [255.0, 255.0, 0.0]),
+        (3, [0.0, 255.0, 0.0]),
+        (4, [0.0, 255.0, 255.0]),
+        (5, [0.0, 0.0, 255.0]),
+        (6, [255.0, 0.0, 255.0]),
+        (7, [0.0, 0.0, 0.0]),
+        (7, [255.0, 255.0, 255.0]),
+    ];
+    standard
+        .iter()
+        .min_by(|(_, p), (_, q)| {
+            let d = |c: &[f64; 3]| (c[0] - r).powi(2) + (c[1] - g).powi(2) + (c[2] - b).powi(2);
+            d(p).total_cmp(&d(q))
+        })
+        .map_or(7, |(aci, _)| *aci)
+}
+
+/// How sheets are drawn: the layers, and which face the labels read on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SheetStyle {
+    /// Every kind's layer.
+    pub layers: Layers,
+    /// Labels mirrored, to read on the inside face (`--labels inside`).
+    pub labels_inside: bool,
 }
 
 /// Receives sheet geometry in sheet coordinates (mm, origin lower-left, y up).
@@ -107,22 +200,20 @@ impl Format {
         layout: &Layout,
         index: usize,
         panels: &FlatPanels,
-        stroke_width: f64,
+        style: &SheetStyle,
     ) -> Vec<u8> {
         let sheet = &layout.sheet;
+        let inside = style.labels_inside;
+        let order = PathOrder::Shortest;
         match self {
             Format::Svg => {
-                let style = svg::SvgStyle {
-                    stroke_width,
-                    ..svg::SvgStyle::default()
-                };
-                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, style);
-                draw_sheet(layout, index, panels, &mut sink);
+                let mut sink = svg::SvgSheet::new(sheet.width, sheet.height, &style.layers);
+                draw_sheet(layout, index, panels, inside, order, &mut sink);
                 sink.finish().into_bytes()
             }
             Format::Dxf => {
-                let mut sink = dxf::DxfSheet::new(sheet.width, sheet.height);
-                draw_sheet(layout, index, panels, &mut sink);
+                let mut sink = dxf::DxfSheet::new(sheet.width, sheet.height, &style.layers);
+                draw_sheet(layout, index, panels, inside, order, &mut sink);
                 sink.finish().into_bytes()
             }
         }
@@ -140,6 +231,30 @@ pub struct Lengths {
     pub score_valley: f64,
     /// Engrave length.
     pub engrave: f64,
+    /// Travel with the beam off, between the end of one path and the start of the
+    /// next, in the order they were drawn.
+    pub travel: f64,
+    /// Where the last path drawn ended.
+    pub last_end: Option<DVec2>,
+}
+
+impl Lengths {
+    /// The beam moves to `start` and leaves at `end`.
+    fn run(&mut self, start: DVec2, end: DVec2) {
+        if let Some(at) = self.last_end {
+            self.travel += at.distance(start);
+        }
+        self.last_end = Some(end);
+    }
+
+    /// These lengths and `other`'s, added (the travel between them not counted).
+    pub fn add(&mut self, other: &Lengths) {
+        self.cut += other.cut;
+        self.score += other.score;
+        self.score_valley += other.score_valley;
+        self.engrave += other.engrave;
+        self.travel += other.travel;
+    }
 }
 
 /// A sink that only measures.
@@ -150,9 +265,14 @@ impl SheetSink for Lengths {
             length += points[points.len() - 1].distance(points[0]);
         }
         *self.slot(kind) += length;
+        if let (Some(&first), Some(&last)) = (points.first(), points.last()) {
+            self.run(first, if closed { first } else { last });
+        }
     }
-    fn circle(&mut self, kind: Kind, _center: DVec2, radius: f64) {
+    fn circle(&mut self, kind: Kind, center: DVec2, radius: f64) {
         *self.slot(kind) += std::f64::consts::TAU * radius;
+        let start = center + DVec2::new(radius, 0.0);
+        self.run(start, start);
     }
 }
 
@@ -167,65 +287,99 @@ impl Lengths {
     }
 }
 
-/// Draws sheet `index` of `layout` into `sink`.
-pub fn draw_sheet(layout: &Layout, index: usize, panels: &FlatPanels, sink: &mut dyn SheetSink) {
+/// The order paths are drawn in, within the engrave, score, valley score, cut order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PathOrder {
+    /// Nearest first from the laser's home (the sheet's top-left corner), to keep the
+    /// travel short: what the files get.
+    Shortest,
+    /// Part by part as the parts were placed: the baseline the travel saved is
+    /// measured against.
+    AsPlaced,
+}
+
+/// Draws sheet `index` of `layout` into `sink`, the labels mirrored when
+/// `labels_inside`, the paths of each kind in `order` (a part's holes and inner cuts
+/// always before its outline).
+pub fn draw_sheet(
+    layout: &Layout,
+    index: usize,
+    panels: &FlatPanels,
+    labels_inside: bool,
+    order: PathOrder,
+    sink: &mut dyn SheetSink,
+) {
     let on_sheet: Vec<&Placement> = layout
         .placements
         .iter()
         .filter(|p| p.sheet == index)
         .collect();
-    for p in &on_sheet {
-        draw_labels(panels.get(p.part), p, sink);
-    }
+    let mut groups: [Vec<laser::Group>; 4] = Default::default();
     for p in &on_sheet {
         let panel = panels.get(p.part);
-        for fold in panel
-            .folds
+        groups[Kind::Engrave as usize].extend(label_groups(panel, p, labels_inside));
+        for fold in panel.folds {
+            let points = fold
+                .ends
+                .map(|i| p.apply(panel.points[i as usize]))
+                .to_vec();
+            groups[Kind::of_fold(fold.kind, p.mirrored) as usize].push(laser::Group {
+                paths: vec![laser::Path::Polyline {
+                    points,
+                    closed: false,
+                }],
+                last_fixed: false,
+                keep_order: false,
+            });
+        }
+        let mut cut: Vec<laser::Path> = panel
+            .holes
             .iter()
-            .filter(|f| Kind::of_fold(f.kind, p.mirrored) == Kind::Score)
-        {
-            draw_fold(panel, p, fold, sink);
-        }
-    }
-    for p in &on_sheet {
-        let panel = panels.get(p.part);
-        for fold in panel
-            .folds
-            .iter()
-            .filter(|f| Kind::of_fold(f.kind, p.mirrored) == Kind::ScoreValley)
-        {
-            draw_fold(panel, p, fold, sink);
-        }
-    }
-    for p in &on_sheet {
-        let panel = panels.get(p.part);
-        for hole in panel.holes {
-            sink.circle(Kind::Cut, p.apply(hole.center), 0.5 * hole.diameter);
-        }
-        for lp in panel.outline.iter().skip(1) {
-            let points: Vec<DVec2> = lp
-                .iter()
-                .map(|&i| p.apply(panel.points[i as usize]))
-                .collect();
-            sink.polyline(Kind::Cut, &points, true);
-        }
-        let outer: Vec<DVec2> = panel.outline[0]
-            .iter()
-            .map(|&i| p.apply(panel.points[i as usize]))
+            .map(|hole| laser::Path::Circle {
+                center: p.apply(hole.center),
+                radius: 0.5 * hole.diameter,
+            })
             .collect();
-        sink.polyline(Kind::Cut, &outer, true);
+        // Inner cuts, then the outline last: the part drops out when it is cut.
+        for lp in panel.outline.iter().skip(1).chain(panel.outline.first()) {
+            cut.push(laser::Path::Polyline {
+                points: lp
+                    .iter()
+                    .map(|&i| p.apply(panel.points[i as usize]))
+                    .collect(),
+                closed: true,
+            });
+        }
+        groups[Kind::Cut as usize].push(laser::Group {
+            paths: cut,
+            last_fixed: true,
+            keep_order: false,
+        });
+    }
+    let mut at = DVec2::new(0.0, layout.sheet.height);
+    for (kind, groups) in Kind::ALL.into_iter().zip(groups) {
+        let paths: Vec<laser::Path> = match order {
+            PathOrder::Shortest => {
+                let (paths, end) = laser::order(groups, at);
+                at = end;
+                paths
+            }
+            PathOrder::AsPlaced => groups.into_iter().flat_map(|g| g.paths).collect(),
+        };
+        for path in paths {
+            match path {
+                laser::Path::Polyline { points, closed } => sink.polyline(kind, &points, closed),
+                laser::Path::Circle { center, radius } => sink.circle(kind, center, radius),
+            }
+        }
     }
 }
 
-/// A fold's score line, on its kind's layer.
-fn draw_fold(panel: FlatPanelRef, placement: &Placement, fold: &Fold, sink: &mut dyn SheetSink) {
-    let line = fold.ends.map(|i| placement.apply(panel.points[i as usize]));
-    sink.polyline(Kind::of_fold(fold.kind, placement.mirrored), &line, false);
-}
-
-/// A label's strokes: scaled to its cap height, its box centred on the label centre,
-/// reading along its direction; a panel's own id framed.
-fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetSink) {
+/// Each label's strokes as one group: scaled to its cap height, its box centred on the
+/// label centre, reading along its direction (mirrored in its box when `inside`, so it
+/// reads on the back of the sheet); a panel's own id framed.
+fn label_groups(panel: FlatPanelRef, placement: &Placement, inside: bool) -> Vec<laser::Group> {
+    let mut groups = Vec::with_capacity(panel.labels.len());
     for label in panel.labels {
         let strokes = text_strokes(label.text);
         let h = label.height;
@@ -237,19 +391,34 @@ fn draw_labels(panel: FlatPanelRef, placement: &Placement, sink: &mut dyn SheetS
         }
         let up = d.perp();
         let origin = placement.apply(label.center) - 0.5 * strokes.width * h * d - 0.5 * h * up;
-        for line in &strokes.polylines {
-            let points: Vec<DVec2> = line
-                .iter()
-                .map(|q| origin + q.x * h * d + q.y * h * up)
-                .collect();
-            sink.polyline(Kind::Engrave, &points, false);
-        }
+        let mut paths: Vec<laser::Path> = strokes
+            .polylines
+            .iter()
+            .map(|line| laser::Path::Polyline {
+                points: line
+                    .iter()
+                    .map(|q| {
+                        let x = if inside { strokes.width - q.x } else { q.x };
+                        origin + x * h * d + q.y * h * up
+                    })
+                    .collect(),
+                closed: false,
+            })
+            .collect();
         if label.frame > 0.0 {
             let (w, across) = label_extent(label.frame, strokes.width, h);
-            let frame = label_box(placement.apply(label.center), d, w, across);
-            sink.polyline(Kind::Engrave, &frame, true);
+            paths.push(laser::Path::Polyline {
+                points: label_box(placement.apply(label.center), d, w, across).to_vec(),
+                closed: true,
+            });
         }
+        groups.push(laser::Group {
+            paths,
+            last_fixed: false,
+            keep_order: true,
+        });
     }
+    groups
 }
 
 /// A length in mm with at most 4 decimals, trailing zeros trimmed, never `-0`, never
@@ -280,7 +449,91 @@ pub fn fmt_mm(x: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::fmt_mm;
+    use super::*;
+    use crate::nest::SheetSpec;
+    use crate::panel::{FlatLabel, FlatPanel, LabelKind, Loops, Name, Source};
+
+    /// Records every polyline drawn.
+    #[derive(Default)]
+    struct Recorder(Vec<(Kind, Vec<DVec2>)>);
+
+    impl SheetSink for Recorder {
+        fn polyline(&mut self, kind: Kind, points: &[DVec2], _closed: bool) {
+            self.0.push((kind, points.to_vec()));
+        }
+        fn circle(&mut self, _kind: Kind, _center: DVec2, _radius: f64) {}
+    }
+
+    /// The engraved strokes of a square panel whose one label, "E7", reads along +x
+    /// about x = 50.
+    fn engraved(inside: bool) -> Vec<Vec<DVec2>> {
+        let mut outline = Loops::new();
+        outline.push(0..4);
+        let panel = FlatPanel {
+            source: Source::Edge(7),
+            points: vec![
+                DVec2::new(0.0, 0.0),
+                DVec2::new(100.0, 0.0),
+                DVec2::new(100.0, 100.0),
+                DVec2::new(0.0, 100.0),
+            ],
+            outline,
+            folds: Vec::new(),
+            holes: Vec::new(),
+            labels: vec![FlatLabel {
+                text: Name::Edge(7),
+                center: DVec2::new(50.0, 50.0),
+                direction: DVec2::X,
+                height: 5.0,
+                kind: LabelKind::Partner,
+                frame: 0.0,
+            }],
+            developability_error: 0.0,
+            area: 1e4,
+        };
+        let panels: FlatPanels = [panel].into_iter().collect();
+        let layout = Layout {
+            sheet: SheetSpec {
+                width: 200.0,
+                height: 200.0,
+                margin: 5.0,
+                spacing: 3.0,
+            },
+            sheets: 1,
+            placements: vec![Placement::default()],
+        };
+        let mut sink = Recorder::default();
+        draw_sheet(&layout, 0, &panels, inside, PathOrder::Shortest, &mut sink);
+        sink.0
+            .into_iter()
+            .filter(|(k, _)| *k == Kind::Engrave)
+            .map(|(_, p)| p)
+            .collect()
+    }
+
+    #[test]
+    fn inside_labels_are_the_mirror_image_of_outside_ones() {
+        let (outside, inside) = (engraved(false), engraved(true));
+        assert!(!outside.is_empty());
+        assert_eq!(outside.len(), inside.len());
+        for (o, i) in outside.iter().zip(&inside) {
+            assert_eq!(o.len(), i.len());
+            for (p, q) in o.iter().zip(i) {
+                // Reflected about the label's upright axis, x = 50.
+                assert!((q.x - (100.0 - p.x)).abs() < 1e-9 && (q.y - p.y).abs() < 1e-9);
+            }
+        }
+        assert_ne!(outside, inside, "the glyphs of E7 are not symmetric");
+    }
+
+    #[test]
+    fn standard_colours_have_their_dxf_colours() {
+        let layers = Layers::standard(0.0254);
+        let aci: Vec<u8> = Kind::ALL.iter().map(|&k| layers.aci(k)).collect();
+        assert_eq!(aci, [7, 5, 3, 1]);
+        assert_eq!(nearest_aci("#FF8000"), 2);
+        assert_eq!(nearest_aci("#FFFFFF"), 7);
+    }
 
     #[test]
     fn numbers_are_fixed_and_trimmed() {

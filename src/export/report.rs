@@ -5,6 +5,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use super::manifest::Manifest;
+use crate::units::fmt_num;
 
 /// What the report says beyond the manifest.
 pub struct Extras<'a> {
@@ -19,6 +20,19 @@ pub struct Extras<'a> {
 }
 
 /// A laser path length for the report: millimetres below a metre, metres above.
+/// A time as a person says it: "42 s", "12 min", "5 h 40 min".
+fn duration(seconds: f64) -> String {
+    let s = seconds.max(0.0).round() as u64;
+    if s < 60 {
+        format!("{s} s")
+    } else if s < 3600 {
+        format!("{} min", (s + 30) / 60)
+    } else {
+        let minutes = (s + 30) / 60;
+        format!("{} h {} min", minutes / 60, minutes % 60)
+    }
+}
+
 fn path_length(mm: f64) -> String {
     if mm < 1000.0 {
         format!("{mm:.0} mm")
@@ -86,6 +100,25 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         path_length(m.lengths.engrave),
         m.counts.folds_mountain,
         m.counts.folds_valley
+    );
+    let times: Vec<f64> = m.sheets.iter().map(|s| s.time_s).collect();
+    let (fastest, slowest) = (
+        times.iter().copied().fold(f64::INFINITY, f64::min),
+        times.iter().copied().fold(0.0, f64::max),
+    );
+    let v = &m.laser.speeds;
+    let _ = writeln!(
+        s,
+        "laser time: about {} at cut {}, score {}, engrave {}, travel {} mm/s ({} to {} a sheet); nearest-first order: travel {} instead of {}",
+        duration(m.laser.time_s),
+        fmt_num(v.cut),
+        fmt_num(v.score),
+        fmt_num(v.engrave),
+        fmt_num(v.travel),
+        duration(fastest),
+        duration(slowest),
+        path_length(m.lengths.travel),
+        path_length(m.laser.travel_as_placed)
     );
     // Exact panels carry only float noise, rounded away in the manifest.
     let error = m.max_developability_error;

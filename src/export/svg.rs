@@ -6,64 +6,33 @@ use std::fmt::Write;
 
 use glam::DVec2;
 
-use super::{fmt_mm, Kind, SheetSink};
-
-/// Stroke colours and width.
-#[derive(Clone, Debug, PartialEq)]
-pub struct SvgStyle {
-    /// CUT colour.
-    pub cut: String,
-    /// SCORE colour.
-    pub score: String,
-    /// SCORE-VALLEY colour.
-    pub score_valley: String,
-    /// ENGRAVE colour.
-    pub engrave: String,
-    /// Stroke width (mm).
-    pub stroke_width: f64,
-}
-
-impl Default for SvgStyle {
-    fn default() -> Self {
-        Self {
-            cut: "#FF0000".into(),
-            score: "#0000FF".into(),
-            score_valley: "#00FF00".into(),
-            engrave: "#000000".into(),
-            stroke_width: 0.0254,
-        }
-    }
-}
+use super::{fmt_mm, Kind, Layers, SheetSink};
 
 /// Collects one sheet's elements; [`SvgSheet::finish`] writes the document.
 pub struct SvgSheet {
     width: f64,
     height: f64,
-    style: SvgStyle,
+    layers: Layers,
     groups: [String; 4],
 }
 
 impl SvgSheet {
     /// A sheet of `width` × `height` mm.
-    pub fn new(width: f64, height: f64, style: SvgStyle) -> Self {
+    pub fn new(width: f64, height: f64, layers: &Layers) -> Self {
         Self {
             width,
             height,
-            style,
+            layers: layers.clone(),
             groups: Default::default(),
         }
     }
 
     fn attributes(&self, kind: Kind) -> String {
-        let colour = match kind {
-            Kind::Cut => &self.style.cut,
-            Kind::Score => &self.style.score,
-            Kind::ScoreValley => &self.style.score_valley,
-            Kind::Engrave => &self.style.engrave,
-        };
+        let style = self.layers.of(kind);
         format!(
-            "fill=\"none\" stroke=\"{colour}\" stroke-width=\"{}\"",
-            fmt_mm(self.style.stroke_width)
+            "fill=\"none\" stroke=\"{}\" stroke-width=\"{}\"",
+            style.color,
+            fmt_mm(style.stroke_width)
         )
     }
 
@@ -87,7 +56,7 @@ impl SvgSheet {
                 out,
                 "<g id=\"{}\" inkscape:groupmode=\"layer\" inkscape:label=\"{}\">",
                 kind.layer().to_ascii_lowercase(),
-                kind.layer()
+                self.layers.of(*kind).name
             );
             out.push_str(body);
             out.push_str("</g>\n");

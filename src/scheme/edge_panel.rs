@@ -350,7 +350,7 @@ pub fn place_pins(
 }
 
 /// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
-/// face order), widened where corners need it ([`widen_bands`]), then the panels, the
+/// face order), widened where corners need it (`widen_bands`), then the panels, the
 /// connection count (one per face corner) and the report lines.
 pub fn edge_scheme(
     mesh: &Mesh,

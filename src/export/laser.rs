@@ -1,0 +1,312 @@
+//! The laser's time: speeds per kind, the travel between paths, and the order that
+//! keeps it short. [`super::draw_sheet`] hands the paths of each kind to [`order`],
+//! which runs them nearest first (a part's holes and inner cuts still before its
+//! outline); the [`super::Lengths`] sink measures the travel of whatever order it is
+//! given.
+
+use glam::DVec2;
+
+/// Laser speeds (mm/s): cutting, scoring (both fold kinds), engraving, and moving
+/// with the beam off.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Speeds {
+    /// Cut speed.
+    pub cut: f64,
+    /// Score speed.
+    pub score: f64,
+    /// Engrave (vector line) speed.
+    pub engrave: f64,
+    /// Travel speed, beam off.
+    pub travel: f64,
+}
+
+impl Default for Speeds {
+    /// For 300 gsm card on a 40 W CO2 laser: cut through at 15 mm/s, score at low
+    /// power at 50 mm/s, engrave lines at 100 mm/s, travel at 300 mm/s.
+    fn default() -> Self {
+        Speeds {
+            cut: 15.0,
+            score: 50.0,
+            engrave: 100.0,
+            travel: 300.0,
+        }
+    }
+}
+
+impl Speeds {
+    /// Parses `cut=10,score=40,engrave=80,travel=300` (any of them; the rest keep
+    /// their defaults).
+    pub fn parse(text: &str) -> Result<Speeds, String> {
+        let mut speeds = Speeds::default();
+        for part in text.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            let Some((name, value)) = part.split_once('=') else {
+                return Err(format!(
+                    "--speeds: \"{part}\" is not KIND=MM_PER_S; write like cut=10,score=40,engrave=80,travel=300"
+                ));
+            };
+            let number: f64 = value
+                .trim()
+                .trim_end_matches("mm/s")
+                .parse()
+                .ok()
+                .filter(|v: &f64| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| {
+                    format!("--speeds: {name}={value}: a speed is a positive number of mm/s, like {name}=20")
+                })?;
+            match name.trim() {
+                "cut" => speeds.cut = number,
+                "score" => speeds.score = number,
+                "engrave" => speeds.engrave = number,
+                "travel" => speeds.travel = number,
+                other => {
+                    return Err(format!(
+                        "--speeds: unknown kind \"{other}\"; the kinds are cut, score, engrave and travel"
+                    ))
+                }
+            }
+        }
+        Ok(speeds)
+    }
+
+    /// Seconds to run `lengths` (mm) at these speeds.
+    pub fn seconds(&self, lengths: &super::Lengths) -> f64 {
+        lengths.cut / self.cut
+            + (lengths.score + lengths.score_valley) / self.score
+            + lengths.engrave / self.engrave
+            + lengths.travel / self.travel
+    }
+}
+
+/// One path to run: a polyline (closed or open) or a circle.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Path {
+    /// Points; a closed one ends where it starts.
+    Polyline {
+        /// Its points.
+        points: Vec<DVec2>,
+        /// Joined back to the first point.
+        closed: bool,
+    },
+    /// A circle, started on its rightmost point.
+    Circle {
+        /// Centre.
+        center: DVec2,
+        /// Radius.
+        radius: f64,
+    },
+}
+
+impl Path {
+    /// Where the beam starts it.
+    pub fn start(&self) -> DVec2 {
+        match self {
+            Path::Polyline { points, .. } => points.first().copied().unwrap_or(DVec2::ZERO),
+            Path::Circle { center, radius } => *center + DVec2::new(*radius, 0.0),
+        }
+    }
+
+    /// Where the beam leaves it.
+    pub fn end(&self) -> DVec2 {
+        match self {
+            Path::Polyline { points, closed } => {
+                if *closed {
+                    self.start()
+                } else {
+                    points.last().copied().unwrap_or(DVec2::ZERO)
+                }
+            }
+            Path::Circle { .. } => self.start(),
+        }
+    }
+
+    /// An open polyline can be run from either end.
+    fn reversible(&self) -> bool {
+        matches!(self, Path::Polyline { closed: false, .. })
+    }
+
+    fn reverse(&mut self) {
+        if let Path::Polyline { points, .. } = self {
+            points.reverse();
+        }
+    }
+}
+
+/// Paths that run together, in their own order, and how they end: a part's cut paths
+/// (holes and inner cuts, then the outline last), a label's strokes, a fold.
+#[derive(Clone, Debug)]
+pub struct Group {
+    /// Its paths. With `last_fixed`, the last one runs last; the rest are run nearest
+    /// first.
+    pub paths: Vec<Path>,
+    /// The last path must run last (a part's outline: the part drops out when cut).
+    pub last_fixed: bool,
+    /// The paths keep their order (a label's strokes).
+    pub keep_order: bool,
+}
+
+/// The groups of one kind, nearest first from `at`, each group's free paths nearest
+/// first too (open ones entered at their nearer end). Returns the paths in running
+/// order and where the beam ends. Ties go to the earlier group or path, so the order
+/// is the same on every run.
+pub fn order(groups: Vec<Group>, mut at: DVec2) -> (Vec<Path>, DVec2) {
+    let mut left: Vec<Option<Group>> = groups.into_iter().map(Some).collect();
+    let mut out = Vec::new();
+    for _ in 0..left.len() {
+        // The group whose entry is nearest.
+        let mut best: Option<(f64, usize)> = None;
+        for (i, g) in left.iter().enumerate() {
+            let Some(g) = g else { continue };
+            let d = entry_distance(g, at);
+            if best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, i));
+            }
+        }
+        let Some((_, i)) = best else { break };
+        let group = left[i].take().expect("chosen groups are present");
+        let (paths, end) = order_group(group, at);
+        out.extend(paths);
+        at = end;
+    }
+    (out, at)
+}
+
+/// How far the beam moves from `at` to start `group`.
+fn entry_distance(group: &Group, at: DVec2) -> f64 {
+    let free = if group.last_fixed {
+        &group.paths[..group.paths.len().saturating_sub(1)]
+    } else {
+        &group.paths[..]
+    };
+    let candidates = if group.keep_order || free.is_empty() {
+        &group.paths[..group.paths.len().min(1)]
+    } else {
+        free
+    };
+    candidates
+        .iter()
+        .map(|p| {
+            let d = p.start().distance(at);
+            if p.reversible() {
+                d.min(p.end().distance(at))
+            } else {
+                d
+            }
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A group's paths in running order from `at`, and where the beam ends.
+fn order_group(group: Group, mut at: DVec2) -> (Vec<Path>, DVec2) {
+    let Group {
+        mut paths,
+        last_fixed,
+        keep_order,
+    } = group;
+    if keep_order {
+        let end = paths.last().map_or(at, Path::end);
+        return (paths, end);
+    }
+    let fixed = if last_fixed { paths.pop() } else { None };
+    let mut left: Vec<Option<Path>> = paths.into_iter().map(Some).collect();
+    let mut out = Vec::with_capacity(left.len() + 1);
+    for _ in 0..left.len() {
+        let mut best: Option<(f64, usize, bool)> = None;
+        for (i, p) in left.iter().enumerate() {
+            let Some(p) = p else { continue };
+            let forward = p.start().distance(at);
+            if best.is_none_or(|(b, _, _)| forward < b) {
+                best = Some((forward, i, false));
+            }
+            if p.reversible() {
+                let backward = p.end().distance(at);
+                if best.is_none_or(|(b, _, _)| backward < b) {
+                    best = Some((backward, i, true));
+                }
+            }
+        }
+        let Some((_, i, reversed)) = best else { break };
+        let mut path = left[i].take().expect("chosen paths are present");
+        if reversed {
+            path.reverse();
+        }
+        at = path.end();
+        out.push(path);
+    }
+    if let Some(path) = fixed {
+        at = path.end();
+        out.push(path);
+    }
+    (out, at)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn line(a: (f64, f64), b: (f64, f64)) -> Path {
+        Path::Polyline {
+            points: vec![DVec2::new(a.0, a.1), DVec2::new(b.0, b.1)],
+            closed: false,
+        }
+    }
+
+    fn single(p: Path) -> Group {
+        Group {
+            paths: vec![p],
+            last_fixed: false,
+            keep_order: false,
+        }
+    }
+
+    #[test]
+    fn nearest_first_and_open_paths_turn_round() {
+        let groups = vec![
+            single(line((100.0, 0.0), (90.0, 0.0))),
+            single(line((10.0, 0.0), (20.0, 0.0))),
+            single(line((50.0, 0.0), (40.0, 0.0))),
+        ];
+        let (paths, end) = order(groups, DVec2::ZERO);
+        let starts: Vec<DVec2> = paths.iter().map(Path::start).collect();
+        assert_eq!(
+            starts,
+            [
+                DVec2::new(10.0, 0.0),
+                DVec2::new(40.0, 0.0),
+                DVec2::new(90.0, 0.0)
+            ]
+        );
+        assert_eq!(end, DVec2::new(100.0, 0.0));
+    }
+
+    #[test]
+    fn an_outline_runs_after_its_holes() {
+        let outline = Path::Polyline {
+            points: vec![DVec2::ZERO, DVec2::new(10.0, 0.0), DVec2::new(10.0, 10.0)],
+            closed: true,
+        };
+        let hole = Path::Circle {
+            center: DVec2::new(6.0, 3.0),
+            radius: 1.0,
+        };
+        let group = Group {
+            paths: vec![hole.clone(), outline.clone()],
+            last_fixed: true,
+            keep_order: false,
+        };
+        let (paths, _) = order(vec![group], DVec2::ZERO);
+        assert_eq!(paths, [hole, outline]);
+    }
+
+    #[test]
+    fn speeds_parse_with_defaults_for_the_rest() {
+        let s = Speeds::parse("cut=10, engrave=80").unwrap();
+        assert_eq!(
+            (s.cut, s.score, s.engrave, s.travel),
+            (10.0, 50.0, 80.0, 300.0)
+        );
+        assert!(Speeds::parse("cut=0").is_err());
+        assert!(Speeds::parse("fold=3")
+            .unwrap_err()
+            .contains("unknown kind"));
+    }
+}
