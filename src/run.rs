@@ -50,6 +50,49 @@ struct DrawnSheet {
     entry: manifest::SheetEntry,
 }
 
+/// A spinner on stderr naming the running stage with its time so far: only when stderr
+/// is a terminal and the job is not `--quiet`, so Make and CI logs stay as they were.
+/// Cleared when dropped, whatever the outcome.
+struct Progress(Option<indicatif::ProgressBar>);
+
+impl Progress {
+    fn new(job: &Job) -> Self {
+        use std::io::IsTerminal;
+        if job.quiet || !std::io::stderr().is_terminal() {
+            return Progress(None);
+        }
+        let bar = indicatif::ProgressBar::new_spinner();
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
+            bar.set_style(style);
+        }
+        bar.enable_steady_tick(Duration::from_millis(120));
+        Progress(Some(bar))
+    }
+
+    /// Names the stage now running.
+    fn stage(&self, what: &str) {
+        if let Some(bar) = &self.0 {
+            bar.set_message(what.to_string());
+        }
+    }
+
+    /// Runs `f` (which prints) with the spinner off the screen.
+    fn suspend<R>(&self, f: impl FnOnce() -> R) -> R {
+        match &self.0 {
+            Some(bar) => bar.suspend(f),
+            None => f(),
+        }
+    }
+}
+
+impl Drop for Progress {
+    fn drop(&mut self) {
+        if let Some(bar) = &self.0 {
+            bar.finish_and_clear();
+        }
+    }
+}
+
 struct Stopwatch {
     last: Instant,
     times: Vec<(&'static str, Duration)>,
@@ -505,17 +548,26 @@ pub fn run(job: &Job) -> Result<Outcome> {
 /// (before the long stages), so a user can stop a build that is not what they meant.
 pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let mut clock = Stopwatch::new();
+    let progress = Progress::new(job);
+    let mut warn = |w: &str| progress.suspend(|| warn(w));
     // Refused before the long stages: a folder given as the model, and an output
     // folder that holds files unfold did not write.
     crate::mesh::read::model_format(&job.model_path)?;
     let folder = check_output_folder(&job.out, &job.model_path, job.force)?;
+    progress.stage("reading the model");
     let loaded = load(job)?;
     clock.lap("load");
+    progress.stage(if job.model.budget.is_some() {
+        "simplifying and repairing the mesh"
+    } else {
+        "repairing the mesh"
+    });
     let prepared = prepare(job, loaded)?;
     for warning in &prepared.warnings {
         warn(warning);
     }
     clock.lap("split");
+    progress.stage("making the panels");
     let output = scheme(job, &prepared)?;
     let fastening = crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output);
     // Under --strict it is a refusal after the label check (which may refuse first).
@@ -523,14 +575,17 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         warn(warning);
     }
     clock.lap("scheme");
+    progress.stage("unrolling the panels and fitting their labels");
     let flat = flatten(job, &prepared, &output)?;
     if let Some(warning) = &flat.warning {
         warn(warning);
     }
     crate::sanity::refuse_unfastened(job, fastening.as_ref())?;
     clock.lap("flatten");
+    progress.stage(&format!("nesting {} panels on sheets", flat.panels.len()));
     let nested = nest(job, &flat)?;
     clock.lap("nest");
+    progress.stage(&format!("writing {} sheets", nested.layout.sheets));
     let warnings: Vec<String> = prepared
         .warnings
         .iter()
@@ -544,6 +599,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     notes.extend(nested.notes.iter().cloned());
     notes.extend(folder.write(&files, &job.model_path)?);
     clock.lap("export");
+    drop(progress);
     Ok(Outcome {
         manifest,
         files: files.into_iter().map(|(n, _)| n).collect(),

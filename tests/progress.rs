@@ -1,0 +1,57 @@
+//! Progress on stderr: shown under a terminal, never in a log. `script` (util-linux)
+//! gives the run a terminal; without it the terminal half is skipped with a message.
+
+mod common;
+
+use std::process::Command;
+
+use tempfile::TempDir;
+
+use common::build::*;
+
+#[test]
+fn progress_shows_on_a_terminal_and_never_in_a_log() {
+    let tmp = TempDir::new().unwrap();
+    let model = model("genus2");
+    let out = tmp.path().join("log");
+    // stderr is a pipe here, as under Make or CI.
+    let (_, run) = build_run("half-edge", &model, "300mm", &out, &[]);
+    for sign in ["nesting", "\r", "\u{1b}["] {
+        assert!(
+            !run.stderr.contains(sign),
+            "{sign:?} in a log:\n{}",
+            run.stderr
+        );
+    }
+
+    let has_script = Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("progress: `script` is missing; the terminal half is skipped");
+        return;
+    }
+    let out = tmp.path().join("terminal");
+    let line = format!(
+        "{} {} --size 300mm --out {}",
+        env!("CARGO_BIN_EXE_unfold"),
+        model.display(),
+        out.display()
+    );
+    let run = Command::new("script")
+        .args(["-qec", &line, "/dev/null"])
+        .output()
+        .expect("script runs");
+    assert!(run.status.success());
+    let shown = String::from_utf8_lossy(&run.stdout);
+    assert!(shown.contains("nesting 50 panels on sheets"), "{shown}");
+    // The report still follows, and the spinner is cleared before it.
+    assert!(shown.contains("wrote 5 files"), "{shown}");
+    // --quiet shows nothing, terminal or not.
+    let quiet = Command::new("script")
+        .args(["-qec", &format!("{line}-quiet --quiet"), "/dev/null"])
+        .output()
+        .expect("script runs");
+    assert!(!String::from_utf8_lossy(&quiet.stdout).contains("nesting"));
+}
