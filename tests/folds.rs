@@ -60,7 +60,26 @@ fn facets_on(panel: &Panel, a: u32, b: u32) -> Vec<usize> {
 
 /// The mesh edge that carries the segment `p`–`q` (within `tol`), if any.
 fn edge_under(mesh: &Mesh, p: DVec3, q: DVec3, tol: f64) -> Option<EdgeId> {
-    mesh.edges().find(|&e| {
+    // Only edges at one of the fold's ends can carry it: those of the vertices
+    // nearest its ends.
+    let nearest = |x: DVec3| {
+        mesh.vertices()
+            .min_by(|&a, &b| {
+                mesh.position(a)
+                    .distance(x)
+                    .total_cmp(&mesh.position(b).distance(x))
+            })
+            .expect("a mesh has vertices")
+    };
+    let near: Vec<EdgeId> = [nearest(p), nearest(q)]
+        .into_iter()
+        .flat_map(|v| {
+            mesh.vertex_outgoing(v)
+                .map(|h| h.edge())
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    near.into_iter().find(|&e| {
         let (u, w) = mesh.edge_vertices(e);
         let (u, w) = (mesh.position(u), mesh.position(w));
         let d = (w - u).normalize();
