@@ -109,16 +109,10 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
                 hinges.push((g, f, a, b));
                 let (nf, ng) = (normals[f as usize], normals[g as usize]);
                 if nf.angle_between(ng) > flat_fold {
-                    // Facets wind counter-clockwise seen from outside: the edge runs
-                    // from → to in f, and the normals turn about it the positive way
-                    // exactly when the edge is convex.
+                    // The edge runs from → to in f.
                     let along =
                         panel.vertices[f_use.to as usize] - panel.vertices[f_use.from as usize];
-                    let kind = if nf.cross(ng).dot(along) > 0.0 {
-                        FoldKind::Mountain
-                    } else {
-                        FoldKind::Valley
-                    };
+                    let kind = FoldKind::between(nf, ng, along);
                     folds.push(Fold { ends: [a, b], kind });
                 }
             }

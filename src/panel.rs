@@ -700,6 +700,19 @@ pub enum FoldKind {
     Valley,
 }
 
+impl FoldKind {
+    /// The fold between two faces wound counter-clockwise seen from outside, with
+    /// normals `nf` and `ng`, along an edge that runs `along` in the first: the
+    /// normals turn about the edge the positive way exactly when it is convex.
+    pub fn between(nf: DVec3, ng: DVec3, along: DVec3) -> FoldKind {
+        if nf.cross(ng).dot(along) > 0.0 {
+            FoldKind::Mountain
+        } else {
+            FoldKind::Valley
+        }
+    }
+}
+
 /// A fold line to score: a hinge between two facets that are not coplanar.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Fold {

@@ -137,6 +137,18 @@ pub(crate) fn short_number(x: f64) -> String {
     }
 }
 
+/// A path length for a report: whole millimetres below a metre, else metres with one
+/// decimal ("472 mm", "12.7 m").
+pub(crate) fn fmt_path_length(mm: f64) -> String {
+    // An empty sum is -0.0; written, it would read "-0 mm".
+    let mm = mm + 0.0;
+    if mm < 1000.0 {
+        format!("{mm:.0} mm")
+    } else {
+        format!("{:.1} m", mm / 1000.0)
+    }
+}
+
 /// A number with at most 4 decimals, trailing zeros trimmed (for reports).
 pub(crate) fn fmt_num(x: f64) -> String {
     let s = format!("{x:.4}");

@@ -5,7 +5,7 @@ use std::path::Path;
 use std::time::Duration;
 
 use super::manifest::Manifest;
-use crate::units::fmt_num;
+use crate::units::{fmt_num, fmt_path_length};
 
 /// What the report says beyond the manifest.
 pub struct Extras<'a> {
@@ -19,7 +19,6 @@ pub struct Extras<'a> {
     pub files: &'a [String],
 }
 
-/// A laser path length for the report: millimetres below a metre, metres above.
 /// A time as a person says it: "42 s", "12 min", "5 h 40 min".
 fn duration(seconds: f64) -> String {
     let s = seconds.max(0.0).round() as u64;
@@ -30,14 +29,6 @@ fn duration(seconds: f64) -> String {
     } else {
         let minutes = (s + 30) / 60;
         format!("{} h {} min", minutes / 60, minutes % 60)
-    }
-}
-
-fn path_length(mm: f64) -> String {
-    if mm < 1000.0 {
-        format!("{mm:.0} mm")
-    } else {
-        format!("{:.1} m", mm / 1000.0)
     }
 }
 
@@ -94,10 +85,10 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
     let _ = writeln!(
         s,
         "laser paths: cut {}, score {}, valley score {}, engrave {}; {} mountain and {} valley folds",
-        path_length(m.lengths.cut),
-        path_length(m.lengths.score),
-        path_length(m.lengths.score_valley),
-        path_length(m.lengths.engrave),
+        fmt_path_length(m.lengths.cut),
+        fmt_path_length(m.lengths.score),
+        fmt_path_length(m.lengths.score_valley),
+        fmt_path_length(m.lengths.engrave),
         m.counts.folds_mountain,
         m.counts.folds_valley
     );
@@ -117,8 +108,8 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         fmt_num(v.travel),
         duration(fastest),
         duration(slowest),
-        path_length(m.lengths.travel),
-        path_length(m.laser.travel_as_placed)
+        fmt_path_length(m.lengths.travel),
+        fmt_path_length(m.laser.travel_as_placed)
     );
     // Exact panels carry only float noise, rounded away in the manifest.
     let error = m.max_developability_error;

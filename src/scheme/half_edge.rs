@@ -105,11 +105,33 @@ struct HalfEdgeArgs {
     #[arg(long, value_name = "KIND")]
     connectors: Option<Connectors>,
 
+    #[command(flatten)]
+    tab: TabArgs,
+}
+
+/// The tab option of the schemes that glue tabs (half-edge, net), as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub(super) struct TabArgs {
     /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
     /// where the neighbour is smaller. [default: 8mm]
     #[arg(long, value_name = "LENGTH")]
     tab_height: Option<String>,
 }
+
+impl TabArgs {
+    /// The tab height (mm), checked, or its default.
+    pub(super) fn height(&self) -> Result<f64, String> {
+        crate::units::positive_length("tab-height", self.tab_height.as_deref(), "8mm")
+    }
+}
+
+/// The defaults of the schemes that glue whole faces with tabs (half-edge, net): faces
+/// whole, no holes unless asked (glue holds), up to two through each tab.
+pub(super) const TAB_DEFAULTS: PanelDefaults = PanelDefaults {
+    face_scale: 1.0,
+    holes: 0,
+    holes_allowed: &[0, 1, 2],
+};
 
 /// The half-edge scheme's options, resolved (lengths in mm).
 #[derive(Clone, Debug, PartialEq)]
@@ -136,11 +158,7 @@ impl Scheme for HalfEdge {
     }
 
     fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            face_scale: 1.0,
-            holes: 0,
-            holes_allowed: &[0, 1, 2],
-        }
+        TAB_DEFAULTS
     }
 
     fn needs_convex_faces(&self) -> bool {
@@ -157,11 +175,7 @@ impl Scheme for HalfEdge {
         Ok(Box::new(HalfEdgeOptions {
             panel,
             tabs: args.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
-            tab_height: crate::units::positive_length(
-                "tab-height",
-                args.tab_height.as_deref(),
-                "8mm",
-            )?,
+            tab_height: args.tab.height()?,
         }))
     }
 }

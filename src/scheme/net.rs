@@ -24,13 +24,14 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
-use super::half_edge::{make_tab, HalfEdgeOptions, Tab};
-use super::{args_of, Configured, OptionValues, PanelDefaults, PanelLimit, PanelOptions};
+use super::half_edge::{make_tab, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::panel::{FoldKind, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{convex_hull, fits_rotated};
 use crate::record::{round4, Params};
+use crate::units::fmt_path_length;
 
 /// Least distance (mm) between two faces or tabs of one island that are not joined:
 /// the laser needs room between two cuts, and an outline that touches itself is not
@@ -54,10 +55,8 @@ pub struct Net;
 /// The net scheme's options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 struct NetArgs {
-    /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
-    /// where the neighbour is smaller. [default: 8mm]
-    #[arg(long, value_name = "LENGTH")]
-    tab_height: Option<String>,
+    #[command(flatten)]
+    tab: TabArgs,
 
     /// Most faces in one island (net scheme), for builders who want small pieces.
     /// [default: no limit]
@@ -105,11 +104,7 @@ impl Scheme for Net {
     }
 
     fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            face_scale: 1.0,
-            holes: 0,
-            holes_allowed: &[0, 1, 2],
-        }
+        TAB_DEFAULTS
     }
 
     fn needs_convex_faces(&self) -> bool {
@@ -147,11 +142,7 @@ impl Scheme for Net {
         Ok(Box::new(NetOptions {
             island_spread,
             panel,
-            tab_height: crate::units::positive_length(
-                "tab-height",
-                args.tab_height.as_deref(),
-                "8mm",
-            )?,
+            tab_height: args.tab.height()?,
             max_island_faces: args.max_island_faces,
             flat_fold: flat_fold.to_radians(),
         }))
@@ -369,18 +360,16 @@ impl Islands {
     }
 
     /// Joins the islands of edge `e`'s faces along it when the smaller one, turned
-    /// about the edge, keeps clear of the larger and the union fits `limit` (with room
-    /// `tab` for tabs all round). Every other edge between the two that then lies
-    /// where both its faces put it (a flat region closing up) is folded too. Returns
-    /// whether it joined them.
+    /// about the edge, keeps clear of the larger and the union fits the sheet (with
+    /// room for a tab's depth) and `rules`. Every other edge between the two that
+    /// then lies where both its faces put it (a flat region closing up) is folded
+    /// too. Returns whether it joined them.
     fn try_join(&mut self, mesh: &Mesh, e: EdgeId, rules: &JoinRules<'_>) -> bool {
         let JoinRules {
-            limit,
-            most,
+            options,
             scale,
             spread,
             small,
-            ..
         } = *rules;
         let h = e.half_edge();
         let (Some(f), Some(g)) = (mesh.face(h), mesh.face(h.twin())) else {
@@ -392,186 +381,59 @@ impl Islands {
         }
         let (size_a, size_b) = (self.faces[ia as usize].len(), self.faces[ib as usize].len());
         let total = size_a + size_b;
-        if most.is_some_and(|m| total > m) || size_a.min(size_b) > small {
+        if options.max_island_faces.is_some_and(|m| total > m) || size_a.min(size_b) > small {
             return false;
         }
-        // The larger island stays put; ties keep the lower index.
-        let big_first = (self.faces[ia as usize].len(), std::cmp::Reverse(ia))
-            >= (self.faces[ib as usize].len(), std::cmp::Reverse(ib));
-        let (ha, hb) = if big_first {
-            (h, h.twin())
+        // The larger island (a) stays put; ties keep the lower index.
+        let big_first = (size_a, std::cmp::Reverse(ia)) >= (size_b, std::cmp::Reverse(ib));
+        let (a, b, ha, hb) = if big_first {
+            (ia, ib, h, h.twin())
         } else {
-            (h.twin(), h)
+            (ib, ia, h.twin(), h)
         };
-        let (a, b) = (
-            self.of_face[face_of(mesh, ha)],
-            self.of_face[face_of(mesh, hb)],
-        );
         // hb runs the edge the other way: its origin sits at ha's destination.
-        let (pa, pb) = (self.corner[ha.index()], self.corner[mesh.next(ha).index()]);
-        let (qa, qb) = (self.corner[mesh.next(hb).index()], self.corner[hb.index()]);
-        let (dp, dq) = ((pb - pa).normalize(), (qb - qa).normalize());
-        let turn = DVec2::new(dq.dot(dp), dq.perp_dot(dp));
-        let moved = |x: DVec2| pa + turn.rotate(x - qa);
+        let turn = Turn::onto(
+            (self.corner[mesh.next(hb).index()], self.corner[hb.index()]),
+            (self.corner[ha.index()], self.corner[mesh.next(ha).index()]),
+        );
 
         let mut hull: Vec<DVec2> = self.hull[a as usize].clone();
-        hull.extend(self.hull[b as usize].iter().map(|&x| moved(x)));
+        hull.extend(self.hull[b as usize].iter().map(|&x| turn.apply(x)));
         let hull = convex_hull(&hull);
         let area = self.area[a as usize] + self.area[b as usize];
         if crate::plane::area(&hull) > spread * area && total > 2 {
             return false;
         }
-        if let Some((limit, tab)) = limit {
-            // Room for a tab's depth: tabs that would still stick out are cut back.
-            let room = tab + FIT_SLACK;
-            if !fits_rotated(
-                &hull,
-                limit.rotations,
-                limit.width - room,
-                limit.height - room,
-            ) {
-                return false;
-            }
+        // Room for a tab's depth: tabs that would still stick out are cut back.
+        if !fits_sheet(&hull, options, options.tab_height + FIT_SLACK) {
+            return false;
         }
 
-        // The edges joined: this one, and every edge between the two islands whose
-        // corners land together.
-        let mut joins: Vec<HalfedgeId> = vec![hb];
-        for &y in &self.faces[b as usize] {
-            for hy in mesh.face_half_edges(FaceId(y)) {
-                if hy == hb {
-                    continue;
-                }
-                let hx = hy.twin();
-                let Some(x) = mesh.face(hx) else { continue };
-                if self.of_face[x.index()] != a {
-                    continue;
-                }
-                let lands = same_point(
-                    moved(self.corner[hy.index()]),
-                    self.corner[mesh.next(hx).index()],
-                    scale,
-                ) && same_point(
-                    moved(self.corner[mesh.next(hy).index()]),
-                    self.corner[hx.index()],
-                    scale,
-                );
-                if lands {
-                    joins.push(hy);
-                }
-            }
-        }
-        // The corner classes these joins merge, as pairs of roots (a local
-        // union-find over them says which corners become one vertex).
-        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        let joins = self.landing_edges(mesh, (a, b), hb, &turn, scale);
+        // The corner classes these joins merge.
+        let mut pending = PendingCorners::default();
         for &hy in &joins {
             let hx = hy.twin();
-            pairs.push((self.joined.find(hy.0), self.joined.find(mesh.next(hx).0)));
-            pairs.push((self.joined.find(mesh.next(hy).0), self.joined.find(hx.0)));
+            pending.join(self.joined.find(hy.0), self.joined.find(mesh.next(hx).0));
+            pending.join(self.joined.find(mesh.next(hy).0), self.joined.find(hx.0));
         }
-        let mut local: HashMap<u32, u32> = HashMap::new();
-        fn root(local: &HashMap<u32, u32>, mut c: u32) -> u32 {
-            while let Some(&p) = local.get(&c) {
-                if p == c {
-                    break;
-                }
-                c = p;
-            }
-            c
-        }
-        for &(p, q) in &pairs {
-            let (rp, rq) = (root(&local, p), root(&local, q));
-            if rp != rq {
-                local.insert(rp.max(rq), rp.min(rq));
-            }
-        }
-        // A cut left between the two islands needs room for its tab: the two copies of
-        // its edge must open by a notch a tab fits in, or lie a low tab apart.
-        let joined_corner = |c: HalfedgeId, d: HalfedgeId| {
-            root(&local, self.joined.find(c.0)) == root(&local, self.joined.find(d.0))
-        };
-        for &y in &self.faces[b as usize] {
-            for hy in mesh.face_half_edges(FaceId(y)) {
-                let hx = hy.twin();
-                let Some(x) = mesh.face(hx) else { continue };
-                if self.of_face[x.index()] != a || joins.contains(&hy) {
-                    continue;
-                }
-                let (y0, y1) = (
-                    moved(self.corner[hy.index()]),
-                    moved(self.corner[mesh.next(hy).index()]),
-                );
-                let (x0, x1) = (self.corner[mesh.next(hx).index()], self.corner[hx.index()]);
-                // y0 and x0 are the same 3D vertex, and so are y1 and x1: a notch when
-                // one pair is one island vertex, else a slit.
-                let notch = joined_corner(hy, mesh.next(hx)) || joined_corner(mesh.next(hy), hx);
-                let need = if notch { NOTCH_GAP } else { ISLAND_GAP };
-                let poly_y: Vec<DVec2> = self
-                    .polygon(mesh, FaceId(y))
-                    .into_iter()
-                    .map(moved)
-                    .collect();
-                let poly_x = self.polygon(mesh, x);
-                // The lowest tab on either side, clear of the other side's face.
-                let fits = [(hy, (y0, y1), &poly_x), (hx, (x1, x0), &poly_y)]
-                    .into_iter()
-                    .any(|(owner, ends, other)| {
-                        let Some(options) = rules.options else {
-                            return true;
-                        };
-                        let low = tab_options(
-                            options,
-                            TAB_STEPS[TAB_STEPS.len() - 1] * options.tab_height,
-                        );
-                        let Some(tab) = make_tab(mesh, owner, &low) else {
-                            return false;
-                        };
-                        let frame = TabFrame::on(mesh, owner, ends);
-                        let obstacle = Obstacle {
-                            outline: other.as_slice().into(),
-                            need,
-                        };
-                        clear_tab(&tab, &frame, &[obstacle], options).is_some()
-                    });
-                if !fits {
-                    return false;
-                }
-            }
-        }
-        // Faces may touch where they will share a vertex.
-        let may_touch = |x: u32, y: u32| {
-            mesh.face_half_edges(FaceId(y)).any(|cy| {
-                let ry = root(&local, self.joined.find(cy.0));
-                mesh.face_half_edges(FaceId(x))
-                    .any(|cx| root(&local, self.joined.find(cx.0)) == ry)
-            })
-        };
-        let grid = &self.grid[a as usize];
-        for &y in &self.faces[b as usize] {
-            let poly: Vec<DVec2> = self
-                .polygon(mesh, FaceId(y))
-                .into_iter()
-                .map(moved)
-                .collect();
-            for x in grid.near(&poly) {
-                let need = if may_touch(x, y) { -TOUCH } else { ISLAND_GAP };
-                if separation(&self.polygon(mesh, FaceId(x)), &poly) < need {
-                    return false;
-                }
-            }
+        if !self.cuts_left_have_room(mesh, (a, b), &joins, &turn, &pending, options)
+            || !self.keeps_clear(mesh, (a, b), &turn, &pending)
+        {
+            return false;
         }
 
         // Join: move b's corners into a's frame.
         let moved_faces = std::mem::take(&mut self.faces[b as usize]);
         for &y in &moved_faces {
             for c in mesh.face_half_edges(FaceId(y)) {
-                self.corner[c.index()] = moved(self.corner[c.index()]);
+                self.corner[c.index()] = turn.apply(self.corner[c.index()]);
             }
             let poly = self.polygon(mesh, FaceId(y));
             self.grid[a as usize].insert(y, &poly);
             self.of_face[y as usize] = a;
         }
-        for (p, q) in pairs {
+        for (p, q) in pending.pairs {
             self.joined.union(p, q);
         }
         for hy in joins {
@@ -584,35 +446,199 @@ impl Islands {
         self.area[a as usize] = area;
         true
     }
+
+    /// The half-edges of island `b`'s faces (`hb`, the joining one, first) whose edge
+    /// lies where island `a`'s face across it puts it once `b` is turned: the edges
+    /// the join folds.
+    fn landing_edges(
+        &self,
+        mesh: &Mesh,
+        (a, b): (u32, u32),
+        hb: HalfedgeId,
+        turn: &Turn,
+        scale: f64,
+    ) -> Vec<HalfedgeId> {
+        let mut joins = vec![hb];
+        for (hy, hx) in self.between(mesh, a, b) {
+            if hy == hb {
+                continue;
+            }
+            let lands = same_point(
+                turn.apply(self.corner[hy.index()]),
+                self.corner[mesh.next(hx).index()],
+                scale,
+            ) && same_point(
+                turn.apply(self.corner[mesh.next(hy).index()]),
+                self.corner[hx.index()],
+                scale,
+            );
+            if lands {
+                joins.push(hy);
+            }
+        }
+        joins
+    }
+
+    /// The pairs (half-edge in a face of island `b`, its twin in a face of island `a`).
+    fn between<'m>(
+        &'m self,
+        mesh: &'m Mesh,
+        a: u32,
+        b: u32,
+    ) -> impl Iterator<Item = (HalfedgeId, HalfedgeId)> + 'm {
+        self.faces[b as usize].iter().flat_map(move |&y| {
+            mesh.face_half_edges(FaceId(y))
+                .filter(move |hy| {
+                    mesh.face(hy.twin())
+                        .is_some_and(|x| self.of_face[x.index()] == a)
+                })
+                .map(|hy| (hy, hy.twin()))
+        })
+    }
+
+    /// True when every cut the join leaves between islands `a` and `b` has room for
+    /// the lowest tab on one of its sides, clear of the other side's face: a notch
+    /// (one end of the two copies of its edge is one island vertex) or a slit.
+    fn cuts_left_have_room(
+        &self,
+        mesh: &Mesh,
+        (a, b): (u32, u32),
+        joins: &[HalfedgeId],
+        turn: &Turn,
+        pending: &PendingCorners,
+        options: &NetOptions,
+    ) -> bool {
+        let low = tab_options(options, TAB_STEPS[TAB_STEPS.len() - 1] * options.tab_height);
+        let joined_corner = |c: HalfedgeId, d: HalfedgeId| {
+            pending.root(self.joined.find(c.0)) == pending.root(self.joined.find(d.0))
+        };
+        self.between(mesh, a, b)
+            .filter(|(hy, _)| !joins.contains(hy))
+            .all(|(hy, hx)| {
+                let (y0, y1) = (
+                    turn.apply(self.corner[hy.index()]),
+                    turn.apply(self.corner[mesh.next(hy).index()]),
+                );
+                let (x0, x1) = (self.corner[mesh.next(hx).index()], self.corner[hx.index()]);
+                // y0 and x0 are the same 3D vertex, and so are y1 and x1.
+                let notch = joined_corner(hy, mesh.next(hx)) || joined_corner(mesh.next(hy), hx);
+                let need = if notch { NOTCH_GAP } else { ISLAND_GAP };
+                let face = |h: HalfedgeId| mesh.face(h).map_or(FaceId(0), |f| f);
+                let poly_y: Vec<DVec2> = self
+                    .polygon(mesh, face(hy))
+                    .into_iter()
+                    .map(|p| turn.apply(p))
+                    .collect();
+                let poly_x = self.polygon(mesh, face(hx));
+                let fits = [(hy, (y0, y1), &poly_x), (hx, (x1, x0), &poly_y)]
+                    .into_iter()
+                    .any(|(owner, ends, other)| {
+                        let Some(tab) = make_tab(mesh, owner, &low) else {
+                            return false;
+                        };
+                        let obstacle = Obstacle {
+                            outline: other.as_slice().into(),
+                            need,
+                        };
+                        let frame = TabFrame::on(mesh, owner, ends);
+                        clear_tab(&tab, &frame, &[obstacle], options).is_some()
+                    });
+                fits
+            })
+    }
+
+    /// True when island `b`, turned, keeps clear of island `a`'s faces: faces that will
+    /// share an island vertex may touch, any other two keep [`ISLAND_GAP`] apart.
+    fn keeps_clear(
+        &self,
+        mesh: &Mesh,
+        (a, b): (u32, u32),
+        turn: &Turn,
+        pending: &PendingCorners,
+    ) -> bool {
+        let may_touch = |x: u32, y: u32| {
+            mesh.face_half_edges(FaceId(y)).any(|cy| {
+                let ry = pending.root(self.joined.find(cy.0));
+                mesh.face_half_edges(FaceId(x))
+                    .any(|cx| pending.root(self.joined.find(cx.0)) == ry)
+            })
+        };
+        let grid = &self.grid[a as usize];
+        self.faces[b as usize].iter().all(|&y| {
+            let poly: Vec<DVec2> = self
+                .polygon(mesh, FaceId(y))
+                .into_iter()
+                .map(|p| turn.apply(p))
+                .collect();
+            grid.near(&poly).into_iter().all(|x| {
+                let need = if may_touch(x, y) { -TOUCH } else { ISLAND_GAP };
+                separation(&self.polygon(mesh, FaceId(x)), &poly) >= need
+            })
+        })
+    }
+}
+
+/// The rigid motion that lays one flat segment onto another (same length): an
+/// island turned about the edge it joins along.
+struct Turn {
+    from: DVec2,
+    to: DVec2,
+    rotation: DVec2,
+}
+
+impl Turn {
+    /// The motion taking segment `from` (q0, q1) onto `to` (p0, p1).
+    fn onto((q0, q1): (DVec2, DVec2), (p0, p1): (DVec2, DVec2)) -> Turn {
+        let (dp, dq) = ((p1 - p0).normalize(), (q1 - q0).normalize());
+        Turn {
+            from: q0,
+            to: p0,
+            rotation: DVec2::new(dq.dot(dp), dq.perp_dot(dp)),
+        }
+    }
+
+    fn apply(&self, x: DVec2) -> DVec2 {
+        self.to + self.rotation.rotate(x - self.from)
+    }
+}
+
+/// Corner classes a join would merge, before it is made: a small union-find over
+/// their roots in [`Corners`], so the checks can ask which corners become one vertex.
+#[derive(Default)]
+struct PendingCorners {
+    parent: HashMap<u32, u32>,
+    /// The pairs of roots to join when the join is made.
+    pairs: Vec<(u32, u32)>,
+}
+
+impl PendingCorners {
+    fn root(&self, mut c: u32) -> u32 {
+        while let Some(&p) = self.parent.get(&c) {
+            c = p;
+        }
+        c
+    }
+
+    fn join(&mut self, p: u32, q: u32) {
+        self.pairs.push((p, q));
+        let (rp, rq) = (self.root(p), self.root(q));
+        if rp != rq {
+            self.parent.insert(rp.max(rq), rp.min(rq));
+        }
+    }
 }
 
 /// What a join must respect.
 #[derive(Clone, Copy)]
 struct JoinRules<'a> {
-    /// The options, for the tabs a join leaves inside an island (`None`: no tabs).
-    options: Option<&'a NetOptions>,
-    /// The largest island a sheet takes, with the room kept for a tab's depth.
-    limit: Option<(PanelLimit, f64)>,
-    /// Most faces in one island.
-    most: Option<usize>,
+    /// The options: the sheet, the island size cap, the tabs.
+    options: &'a NetOptions,
     /// The model's largest edge (for "the same point").
     scale: f64,
     /// Largest ratio of the joined island's convex hull to its area.
     spread: f64,
     /// Join only when the smaller island has at most this many faces.
     small: usize,
-}
-
-/// The face of a half-edge known to have one, as an index.
-fn face_of(mesh: &Mesh, h: HalfedgeId) -> usize {
-    mesh.face(h).map_or(0, |f| f.index())
-}
-
-/// A cut edge's tab as placed.
-struct PlacedTab {
-    tab: Tab,
-    /// Lower or narrower than wanted (by the partner face or the island's room).
-    shortened: bool,
 }
 
 /// The options for a half-edge tab of height `height`.
@@ -688,13 +714,13 @@ struct Obstacle<'a> {
 /// `tab` cut back to keep clear of `obstacles`: each one it comes too near is cut
 /// away along that obstacle's side that leaves the most of the tab. `None` when less
 /// than half its base or under a third of its area is left. The tab's flat outline
-/// (counter-clockwise) comes with it.
+/// (counter-clockwise) comes with it; a tab cut back is marked shortened.
 fn clear_tab(
     tab: &Tab,
     frame: &TabFrame,
     obstacles: &[Obstacle],
     options: &NetOptions,
-) -> Option<(Tab, Vec<DVec2>, bool)> {
+) -> Option<(Tab, Vec<DVec2>)> {
     // Facet order b', a', top…: counter-clockwise, face up.
     let mut poly: Vec<DVec2> = [tab.base[1], tab.base[0]]
         .iter()
@@ -727,7 +753,7 @@ fn clear_tab(
         }
     }
     if !cut {
-        return Some((tab.clone(), poly, false));
+        return Some((tab.clone(), poly));
     }
     if crate::plane::area(&poly) < full_area / 3.0 {
         return None;
@@ -779,19 +805,31 @@ fn clear_tab(
         holes,
         shortened: true,
     };
-    Some((cleared, outline, true))
+    Some((cleared, outline))
+}
+
+/// True when `hull` fits the usable sheet less `room` in one of the nesters'
+/// rotations (always, without a sheet).
+fn fits_sheet(hull: &[DVec2], options: &NetOptions, room: f64) -> bool {
+    options.panel.panel_limit.is_none_or(|limit| {
+        fits_rotated(
+            hull,
+            limit.rotations,
+            limit.width - room,
+            limit.height - room,
+        )
+    })
 }
 
 /// The tabs of every cut edge, by edge (`None`: no room for one). The island's hull,
-/// tabs included, must still fit `limit`.
+/// tabs included, must still fit the sheet.
 fn place_tabs(
     mesh: &Mesh,
     islands: &Islands,
     cuts: &[EdgeId],
-    limit: Option<PanelLimit>,
     options: &NetOptions,
-) -> Vec<Option<PlacedTab>> {
-    let mut placed: Vec<Option<PlacedTab>> = (0..mesh.edge_count()).map(|_| None).collect();
+) -> Vec<Option<Tab>> {
+    let mut placed: Vec<Option<Tab>> = (0..mesh.edge_count()).map(|_| None).collect();
     // Tabs already placed, per island: (owner face, flat outline); and the hulls.
     let mut island_tabs: HashMap<u32, Vec<(u32, Vec<DVec2>)>> = HashMap::new();
     let mut hulls: Vec<Vec<DVec2>> = islands.hull.clone();
@@ -846,27 +884,20 @@ fn place_tabs(
                         need: need(*face),
                     },
                 ));
-                let Some((tab, outline, cut)) = clear_tab(&tab, &frame, &obstacles, options) else {
+                let Some((mut tab, outline)) = clear_tab(&tab, &frame, &obstacles, options) else {
                     continue;
                 };
                 let mut hull = hulls[island as usize].clone();
                 hull.extend_from_slice(&outline);
                 let hull = convex_hull(&hull);
-                if let Some(limit) = limit {
-                    let room = FIT_SLACK;
-                    if !fits_rotated(
-                        &hull,
-                        limit.rotations,
-                        limit.width - room,
-                        limit.height - room,
-                    ) {
-                        continue;
-                    }
+                if !fits_sheet(&hull, options, FIT_SLACK) {
+                    continue;
                 }
                 hulls[island as usize] = hull;
                 others.push((f.0, outline));
-                let shortened = tab.shortened || cut || step < 1.0;
-                placed[e.index()] = Some(PlacedTab { tab, shortened });
+                // Lower than asked for, or cut back (`clear_tab` says so).
+                tab.shortened |= step < 1.0;
+                placed[e.index()] = Some(tab);
                 break 'found;
             }
         }
@@ -893,9 +924,7 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         .collect();
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1 .0.cmp(&y.1 .0)));
     let mut rules = JoinRules {
-        options: Some(options),
-        limit: options.panel.panel_limit.map(|l| (l, options.tab_height)),
-        most: options.max_island_faces,
+        options,
         scale: lengths.last().copied().unwrap_or(1.0),
         spread: options.island_spread,
         small: usize::MAX,
@@ -916,7 +945,7 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
-    let tabs = place_tabs(mesh, &islands, &cuts, options.panel.panel_limit, options);
+    let tabs = place_tabs(mesh, &islands, &cuts, options);
 
     // Islands in the order of their lowest face, numbered from 1.
     let mut members: Vec<Vec<u32>> = islands
@@ -981,11 +1010,7 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         Vec::new()
     } else {
         cuts.iter()
-            .filter(|e| {
-                tabs[e.index()]
-                    .as_ref()
-                    .is_none_or(|t| t.tab.holes.is_empty())
-            })
+            .filter(|e| tabs[e.index()].as_ref().is_none_or(|t| t.holes.is_empty()))
             .filter_map(|&e| {
                 let h = e.half_edge();
                 let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
@@ -1024,7 +1049,7 @@ fn island_panel(
     number: u32,
     faces: &[u32],
     islands: &Islands,
-    tabs: &[Option<PlacedTab>],
+    tabs: &[Option<Tab>],
     match_of: &HashMap<u32, u32>,
     facet_of: &[u32],
     options: &NetOptions,
@@ -1050,9 +1075,9 @@ fn island_panel(
         for h in mesh.face_half_edges(f) {
             facet.push(corner_vertex(h, &mut vertices));
             let e = h.edge();
-            if let Some(placed) = tabs[e.index()].as_ref().filter(|t| t.tab.owner == h) {
-                vertices.push(placed.tab.base[0]);
-                vertices.push(placed.tab.base[1]);
+            if let Some(tab) = tabs[e.index()].as_ref().filter(|t| t.owner == h) {
+                vertices.push(tab.base[0]);
+                vertices.push(tab.base[1]);
                 let n = vertices.len() as u32;
                 facet.push(n - 2);
                 facet.push(n - 1);
@@ -1060,7 +1085,7 @@ fn island_panel(
             }
             // The match number inside this face at a cut edge, unless its tab carries it.
             if let Some(&m) = match_of.get(&e.0) {
-                let owns_tab = tabs[e.index()].as_ref().is_some_and(|t| t.tab.owner == h);
+                let owns_tab = tabs[e.index()].as_ref().is_some_and(|t| t.owner == h);
                 if !owns_tab {
                     let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
                     labels.push(Label {
@@ -1084,12 +1109,12 @@ fn island_panel(
         };
         let facet_index = facets.len() as u32;
         let mut facet = vec![b_base, a_base];
-        for &p in &placed.tab.top {
+        for &p in &placed.top {
             vertices.push(p);
             facet.push((vertices.len() - 1) as u32);
         }
         facets.push(facet);
-        let (a, b) = (placed.tab.base[0], placed.tab.base[1]);
+        let (a, b) = (placed.base[0], placed.base[1]);
         labels.push(Label {
             text: Name::Match(match_of[&e.0]),
             anchor: 0.5 * (a + b),
@@ -1100,7 +1125,7 @@ fn island_panel(
             on_edge: true,
             slide: 0.2 * a.distance(b),
         });
-        for &p in &placed.tab.holes {
+        for &p in &placed.holes {
             holes.push(Hole {
                 position: p,
                 diameter: options.panel.hole_diameter,
@@ -1114,9 +1139,9 @@ fn island_panel(
         for h in mesh.face_half_edges(FaceId(f)) {
             if let Some(placed) = tabs[h.edge().index()]
                 .as_ref()
-                .filter(|t| t.tab.owner == h.twin())
+                .filter(|t| t.owner == h.twin())
             {
-                for &p in &placed.tab.holes {
+                for &p in &placed.holes {
                     holes.push(Hole {
                         position: p,
                         diameter: options.panel.hole_diameter,
@@ -1215,14 +1240,16 @@ impl Summary {
             };
             let (nf, ng) = (mesh.face_normal(f), mesh.face_normal(g));
             let along = mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h));
-            let kind = if nf.angle_between(ng) < options.flat_fold {
+            // Scored as the flatten stage scores them.
+            let slot = if nf.angle_between(ng) <= options.flat_fold {
                 2
-            } else if nf.cross(ng).dot(along) > 0.0 {
-                0
             } else {
-                1
+                match FoldKind::between(nf, ng, along) {
+                    FoldKind::Mountain => 0,
+                    FoldKind::Valley => 1,
+                }
             };
-            folds[kind] += 1;
+            folds[slot] += 1;
         }
         Summary {
             islands: members.len(),
@@ -1246,9 +1273,9 @@ impl Summary {
             self.folds[0],
             self.folds[1],
             self.folds[2],
-            metres(self.fold_length),
+            fmt_path_length(self.fold_length),
             self.cuts,
-            metres(self.cut_length),
+            fmt_path_length(self.cut_length),
             self.tabs
         )]
     }
@@ -1272,15 +1299,5 @@ impl Summary {
             }),
         );
         params
-    }
-}
-
-/// A length in metres with one decimal (mm below a metre), for the report.
-fn metres(mm: f64) -> String {
-    let mm = mm.max(0.0);
-    if mm < 1000.0 {
-        format!("{mm:.0} mm")
-    } else {
-        format!("{:.1} m", mm / 1000.0)
     }
 }
