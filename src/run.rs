@@ -230,6 +230,8 @@ pub struct Flat {
     pub labels_left_out: LeftOut,
     /// The finding when too many panel ids were left out.
     pub warning: Option<String>,
+    /// What the kerf compensation could not do.
+    pub notes: Vec<String>,
 }
 
 /// The panels laid out on sheets.
@@ -314,7 +316,7 @@ pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
 }
 
 /// Stage 4, flatten: unrolls every panel and fits its labels; a panel that overlaps
-/// itself is an error naming it.
+/// itself is an error naming it. Then the cut loops move for the kerf.
 pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<Flat> {
     let mesh = &prepared.scheme_mesh.mesh;
     let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
@@ -343,10 +345,25 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
             bad.id()
         )));
     }
+    let mut notes = Vec::new();
+    let flat = if job.kerf > 0.0 {
+        let compensated = crate::kerf::compensate_all(&flat, job.kerf);
+        if compensated.narrow_panels > 0 {
+            notes.push(format!(
+                "{} panels have cut edges closer together than the {} mm kerf (a tab beside the face next to it, a narrow notch): there the cut stays on its nominal line and the part loses half the kerf",
+                compensated.narrow_panels,
+                crate::units::fmt_num(job.kerf)
+            ));
+        }
+        compensated.panels
+    } else {
+        flat
+    };
     Ok(Flat {
         panels: flat,
         labels_left_out,
         warning,
+        notes,
     })
 }
 
@@ -596,6 +613,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let Exported { files, manifest } = export(job, &prepared, &output, &flat, &nested, warnings)?;
     let mut notes = prepared.notes.clone();
     notes.extend(output.notes.iter().cloned());
+    notes.extend(flat.notes.iter().cloned());
     notes.extend(nested.notes.iter().cloned());
     notes.extend(folder.write(&files, &job.model_path)?);
     clock.lap("export");
@@ -674,7 +692,7 @@ fn build_manifest(
             height: round4(sheet.height),
             margin: round4(sheet.margin),
             spacing: round4(sheet.spacing),
-            kerf: 0.0,
+            kerf: round4(job.kerf),
         },
         counts: manifest::Counts {
             panels: flat.len(),

@@ -358,6 +358,13 @@ pub struct BuildOptions {
     #[arg(long, value_name = "LENGTH")]
     pub spacing: Option<String>,
 
+    /// Laser kerf, the width of material the beam burns away, with a unit: every closed
+    /// cut loop moves half of it into the waste (outlines out, holes and inner cuts in)
+    /// so parts come out at their nominal size; score and engrave lines stay. Below the
+    /// hole diameter. [default: 0mm, nominal geometry]
+    #[arg(long, value_name = "LENGTH")]
+    pub kerf: Option<String>,
+
     /// Output folder, created if missing and replaced whole (never half-written). A
     /// folder holding files unfold did not write is refused. [default: ./NAME, NAME
     /// being the model's file name without extension]
@@ -622,8 +629,10 @@ pub struct Job {
     pub sheet: SheetSize,
     /// Sheet margin, mm.
     pub margin: f64,
-    /// Part spacing, mm.
+    /// Part spacing, mm (between the kerf-compensated outlines).
     pub spacing: f64,
+    /// Laser kerf, mm: cut loops move half of it outward.
+    pub kerf: f64,
     /// Output folder.
     pub out: PathBuf,
     /// Write into an output folder holding other files, keeping them.
@@ -714,6 +723,7 @@ impl BuildOptions {
             sheet: self.sheet.or(other.sheet),
             margin: self.margin.or(other.margin),
             spacing: self.spacing.or(other.spacing),
+            kerf: self.kerf.or(other.kerf),
             out: self.out.or(other.out),
             force: self.force || other.force,
             no_map: self.no_map || other.no_map,
@@ -875,6 +885,17 @@ impl BuildOptions {
             },
         };
         let hole_diameter = length("hole-diameter", &self.hole_diameter, "0.125in")?;
+        let kerf =
+            parse_length(self.kerf.as_deref().unwrap_or("0mm")).map_err(|e| usage("kerf", e))?;
+        if kerf < 0.0 || kerf >= hole_diameter {
+            return Err(usage(
+                "kerf",
+                format!(
+                    "'{}' must be at least 0 and below the {hole_diameter:.3} mm --hole-diameter, which it shrinks by its width",
+                    self.kerf.as_deref().unwrap_or("0mm")
+                ),
+            ));
+        }
         let hole_margin = match &self.hole_margin {
             Some(text) => {
                 let mm = parse_length(text).map_err(|e| usage("hole-margin", e))?;
@@ -925,6 +946,7 @@ impl BuildOptions {
             sheet,
             margin,
             spacing,
+            kerf,
             out,
             force: self.force,
             map: !self.no_map,

@@ -92,6 +92,14 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         m.counts.folds_mountain,
         m.counts.folds_valley
     );
+    if m.sheet.kerf > 0.0 {
+        let _ = writeln!(
+            s,
+            "kerf {} mm: every cut loop is offset {} mm into the waste (outlines out, holes and inner cuts in); the parts come out at their nominal size",
+            fmt_num(m.sheet.kerf),
+            fmt_num(m.sheet.kerf / 2.0)
+        );
+    }
     let times: Vec<f64> = m.sheets.iter().map(|s| s.time_s).collect();
     let (fastest, slowest) = (
         times.iter().copied().fold(f64::INFINITY, f64::min),
