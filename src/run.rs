@@ -21,7 +21,7 @@ use crate::mesh::planarize::{planarize, PlanarizeOptions, PlanarizeReport};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 
-use crate::nest::{lay_out, Layout, SheetSpec};
+use crate::nest::{lay_out_observed, Layout, SheetSpec};
 use crate::panel::{FlatPanelRef, FlatPanels, FoldKind, Source};
 use crate::plane::is_simple;
 use crate::scheme::SchemeOutput;
@@ -50,10 +50,14 @@ struct DrawnSheet {
     entry: manifest::SheetEntry,
 }
 
-/// A spinner on stderr naming the running stage with its time so far: only when stderr
-/// is a terminal and the job is not `--quiet`, so Make and CI logs stay as they were.
-/// Cleared when dropped, whatever the outcome.
+/// A spinner on stderr naming the running stage with its time so far, a bar for the
+/// stage that says how far it has got (the nest): only when stderr is a terminal and
+/// the job is not `--quiet`, so Make and CI logs stay as they were. Cleared when
+/// dropped, whatever the outcome.
 struct Progress(Option<indicatif::ProgressBar>);
+
+/// Steps of a progress bar.
+const BAR_STEPS: u64 = 1000;
 
 impl Progress {
     fn new(job: &Job) -> Self {
@@ -62,17 +66,41 @@ impl Progress {
             return Progress(None);
         }
         let bar = indicatif::ProgressBar::new_spinner();
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
-            bar.set_style(style);
-        }
         bar.enable_steady_tick(Duration::from_millis(120));
         Progress(Some(bar))
     }
 
-    /// Names the stage now running.
+    /// Names the stage now running, with a spinner.
     fn stage(&self, what: &str) {
         if let Some(bar) = &self.0 {
+            if let Ok(style) =
+                indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
+            {
+                bar.set_style(style);
+            }
             bar.set_message(what.to_string());
+        }
+    }
+
+    /// Names the stage now running, with a bar that [`Progress::set`] fills.
+    fn bar(&self, what: &str) {
+        if let Some(bar) = &self.0 {
+            // In this order, so no frame mixes the old stage's name or style with the
+            // new one's.
+            bar.set_length(BAR_STEPS);
+            bar.set_position(0);
+            let template = "{spinner} {msg} [{bar:30}] {percent:>3} % ({elapsed})";
+            if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
+                bar.set_style(style.progress_chars("=> "));
+            }
+            bar.set_message(what.to_string());
+        }
+    }
+
+    /// The bar's stage has done `done` (0 to 1) of its work.
+    fn set(&self, done: f64) {
+        if let Some(bar) = &self.0 {
+            bar.set_position((done.clamp(0.0, 1.0) * BAR_STEPS as f64) as u64);
         }
     }
 
@@ -369,6 +397,11 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
 
 /// Stage 5, nest: lays the flat panels out on sheets.
 pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
+    nest_observed(job, flat, &|_| {})
+}
+
+/// [`nest`], telling `done` the fraction of the search done each time it grows.
+pub fn nest_observed(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Nested> {
     let flat = &flat.panels;
     let sheet = SheetSpec {
         width: job.sheet.width,
@@ -385,7 +418,9 @@ pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
         ))
     };
     let areas: Vec<f64> = flat.iter().map(|p| p.area).collect();
-    let nested = lay_out(&outlines, &areas, sheet, &job.nest).map_err(too_large)?;
+    let progress = crate::nest::NestProgress::new(done);
+    let nested =
+        lay_out_observed(&outlines, &areas, sheet, &job.nest, &progress).map_err(too_large)?;
     let mut notes = Vec::new();
     if let Some(searched) = nested.dropped_search_sheets {
         notes.push(format!(
@@ -599,8 +634,9 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     }
     crate::sanity::refuse_unfastened(job, fastening.as_ref())?;
     clock.lap("flatten");
-    progress.stage(&format!("nesting {} panels on sheets", flat.panels.len()));
-    let nested = nest(job, &flat)?;
+    progress.bar(&format!("nesting {} panels on sheets", flat.panels.len()));
+    let nested = nest_observed(job, &flat, &|done| progress.set(done))?;
+    progress.set(1.0);
     clock.lap("nest");
     progress.stage(&format!("writing {} sheets", nested.layout.sheets));
     let warnings: Vec<String> = prepared

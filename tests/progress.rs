@@ -46,6 +46,16 @@ fn progress_shows_on_a_terminal_and_never_in_a_log() {
     assert!(run.status.success());
     let shown = String::from_utf8_lossy(&run.stdout);
     assert!(shown.contains("nesting 50 panels on sheets"), "{shown}");
+    // The nest has a bar that fills.
+    let percents: Vec<u32> = shown
+        .split(" % (")
+        .filter_map(|before| before.rsplit(']').next()?.trim().parse().ok())
+        .collect();
+    assert!(
+        percents.len() >= 2 && percents[0] == 0,
+        "{percents:?} in {shown}"
+    );
+    assert!(percents.windows(2).all(|w| w[0] <= w[1]), "{percents:?}");
     // The report still follows, and the spinner is cleared before it.
     assert!(shown.contains("wrote 5 files"), "{shown}");
     // --quiet shows nothing, terminal or not.

@@ -8,6 +8,8 @@ pub mod grid;
 pub mod shelf;
 pub mod true_shape;
 
+use std::sync::atomic::{AtomicU32, Ordering};
+
 use glam::DVec2;
 
 use true_shape::NestOptions;
@@ -167,12 +169,34 @@ pub fn lay_out(
     sheet: SheetSpec,
     settings: &NestSettings,
 ) -> Result<Nested, TooLarge> {
+    lay_out_observed(
+        outlines,
+        areas,
+        sheet,
+        settings,
+        &NestProgress::new(&|_| {}),
+    )
+}
+
+/// [`lay_out`], telling `progress` how far the search has got.
+pub fn lay_out_observed(
+    outlines: &[Vec<DVec2>],
+    areas: &[f64],
+    sheet: SheetSpec,
+    settings: &NestSettings,
+    progress: &NestProgress,
+) -> Result<Nested, TooLarge> {
     let shelf = shelf::shelf_layout(outlines, sheet, settings.search.rotations)?;
     let shelf_sheets = shelf.sheets;
     let (mut layout, nester, dropped_search_sheets) = match settings.nester {
         NesterName::Shelf => (shelf, NesterName::Shelf, None),
         NesterName::TrueShape => {
-            let searched = true_shape::true_shape_layout(outlines, sheet, &settings.search)?;
+            let searched = true_shape::true_shape_layout_observed(
+                outlines,
+                sheet,
+                &settings.search,
+                progress,
+            )?;
             if shelf.sheets < searched.sheets {
                 (shelf, NesterName::Shelf, Some(searched.sheets))
             } else {
@@ -188,6 +212,35 @@ pub fn lay_out(
         dropped_search_sheets,
         spacing_bound: spacing_lower_bound(outlines, sheet),
     })
+}
+
+/// How far a layout has got, for a progress display: the share done of each of the
+/// true-shape nester's three phases (two searches, each a construction and its
+/// improvement, then the squeeze of the better one), in thousandths, and whom to tell
+/// when it grows. The layout never reads it back, so a display changes
+/// nothing in the result.
+pub struct NestProgress<'a> {
+    shares: [AtomicU32; 3],
+    tell: &'a (dyn Fn(f64) + Sync),
+}
+
+impl<'a> NestProgress<'a> {
+    /// Nothing done yet; `tell` hears the fraction done (0 to 1) each time it grows.
+    pub fn new(tell: &'a (dyn Fn(f64) + Sync)) -> Self {
+        NestProgress {
+            shares: Default::default(),
+            tell,
+        }
+    }
+
+    /// Phase `phase` (0 to 2) has done `thousandths` of its work.
+    pub(crate) fn set(&self, phase: usize, thousandths: u32) {
+        let thousandths = thousandths.min(1000);
+        if self.shares[phase].fetch_max(thousandths, Ordering::Relaxed) < thousandths {
+            let done: u32 = self.shares.iter().map(|s| s.load(Ordering::Relaxed)).sum();
+            (self.tell)(f64::from(done) / 3000.0);
+        }
+    }
 }
 
 /// The sheets needed if the outlines, each grown by half the spacing, filled the usable

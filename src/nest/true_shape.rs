@@ -48,7 +48,7 @@ mod rows;
 mod separate;
 
 use super::grid::Grid;
-use super::{Layout, Placement, SheetSpec, TooLarge};
+use super::{Layout, NestProgress, Placement, SheetSpec, TooLarge};
 use crate::plane::{bounds, convex_hull, offset_outline};
 use crate::rng::SplitMix64;
 
@@ -194,13 +194,32 @@ struct Nester<'a> {
     /// long they and the squeeze may run together.
     started: Instant,
     time_limit: Duration,
+    /// Where to say how far this search has got, and which phase it is in.
+    progress: Option<(&'a NestProgress<'a>, usize)>,
+    /// The budgeted phase's share of the progress display: thousandths before it and
+    /// its own, from how many checks it spends from which.
+    budget_share: (u32, u32, u64, u64),
 }
+
+/// The share of a search's progress display (thousandths) its construction takes, the
+/// improvement the rest: about their shares of its time at the default effort.
+const CONSTRUCTION_SHARE: u32 = 400;
 
 /// Lays out parts (outer outlines in mm) by their true shapes.
 pub fn true_shape_layout(
     outlines: &[Vec<DVec2>],
     sheet: SheetSpec,
     options: &NestOptions,
+) -> Result<Layout, TooLarge> {
+    true_shape_layout_observed(outlines, sheet, options, &NestProgress::new(&|_| {}))
+}
+
+/// [`true_shape_layout`], telling `progress` how far each search has got.
+pub fn true_shape_layout_observed(
+    outlines: &[Vec<DVec2>],
+    sheet: SheetSpec,
+    options: &NestOptions,
+    progress: &NestProgress,
 ) -> Result<Layout, TooLarge> {
     let (parts, container) = prepare(outlines, sheet, options)?;
     // Two constructions, each improved on its own, and the better kept: rows of
@@ -215,6 +234,7 @@ pub fn true_shape_layout(
     let started = Instant::now();
     let built = |in_rows: bool| -> Result<Nester, usize> {
         let mut nester = Nester::new(&parts, container.clone(), options);
+        nester.progress = Some((progress, usize::from(in_rows)));
         if in_rows {
             nester.construct_in_rows()?;
         } else {
@@ -243,12 +263,14 @@ pub fn true_shape_layout(
     // evaluation costs up to twice what it counts).
     // A sheet of more parts is not tried: each part squeezed into a full sheet sets
     // off a cascade of moves there, and a hundred parts would take minutes.
-    nester.budget = nester.checks + SQUEEZE_CHECKS * u64::from(options.effort.max(1));
+    nester.progress = Some((progress, 2));
+    nester.start_budget(SQUEEZE_CHECKS * u64::from(options.effort.max(1)), 0, 1000);
     while nester.sheets.len() >= 2
         && !nester.out_of_budget()
         && nester.sheets[nester.emptiest()].parts.len() <= SQUEEZE_PARTS * effort
         && nester.squeeze_emptiest(SEPARATION_ROUNDS * effort)
     {}
+    nester.report(0, 1000, 1, 1);
 
     Ok(nester.finish(outlines.len(), sheet))
 }
@@ -516,6 +538,24 @@ impl<'a> Nester<'a> {
             budget: u64::MAX,
             started: Instant::now(),
             time_limit: options.time_limit.unwrap_or(Duration::MAX),
+            progress: None,
+            budget_share: (0, 0, 0, 1),
+        }
+    }
+
+    /// Starts a phase that may spend `spend` more collision checks, worth `weight`
+    /// thousandths of the progress display after `before`.
+    fn start_budget(&mut self, spend: u64, before: u32, weight: u32) {
+        self.budget = self.checks.saturating_add(spend);
+        self.budget_share = (before, weight, self.checks, spend);
+    }
+
+    /// Tells the progress display that this search has done `done` of `of` parts of
+    /// a phase worth `weight` thousandths, after `before` thousandths.
+    fn report(&self, before: u32, weight: u32, done: u64, of: u64) {
+        if let Some((progress, search)) = self.progress {
+            let share = (u64::from(weight) * done.min(of) / of.max(1)) as u32;
+            progress.set(search, before + share);
         }
     }
 
@@ -573,10 +613,11 @@ impl<'a> Nester<'a> {
         let parts = self.parts;
         let mut order: Vec<usize> = (0..parts.len()).collect();
         order.sort_by(|&a, &b| parts[b].area.total_cmp(&parts[a].area).then(a.cmp(&b)));
-        for p in order {
+        for (k, &p) in order.iter().enumerate() {
             if !self.place_anywhere(p) {
                 return Err(p);
             }
+            self.report(0, CONSTRUCTION_SHARE, k as u64 + 1, order.len() as u64);
         }
         Ok(())
     }
@@ -586,7 +627,8 @@ impl<'a> Nester<'a> {
     /// whatever the machine) and the time limit counted from `started`.
     fn improve(&mut self, options: &NestOptions, started: Instant) {
         self.started = started;
-        self.budget = self.checks + self.checks * u64::from(options.effort.max(1)) / 2;
+        let spend = self.checks * u64::from(options.effort.max(1)) / 2;
+        self.start_budget(spend, CONSTRUCTION_SHARE, 1000 - CONSTRUCTION_SHARE);
         let effort = options.effort.max(1) as usize;
         let mut stalled = 0;
         for _ in 0..40 * effort {
@@ -605,6 +647,7 @@ impl<'a> Nester<'a> {
                 }
             }
         }
+        self.report(0, 1000, 1, 1);
     }
 
     /// Fewer sheets, or as many with an emptier emptiest sheet (the objective).

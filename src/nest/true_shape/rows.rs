@@ -98,6 +98,8 @@ impl Nester<'_> {
                 Some((i, rest)) => {
                     let part = left.remove(i);
                     self.put(s, part, rest.pose);
+                    let placed = (parts.len() - left.len()) as u64;
+                    self.report(0, super::CONSTRUCTION_SHARE, placed, parts.len() as u64);
                     if row.height == 0.0 {
                         row.height = rest.height;
                         row.floor = rest.bottom;

@@ -408,6 +408,8 @@ impl Nester<'_> {
     /// Whether the current phase (improvement or squeeze) has spent its collision
     /// checks, or the improvement and squeeze together their time.
     pub(super) fn out_of_budget(&self) -> bool {
+        let (before, weight, first, spend) = self.budget_share;
+        self.report(before, weight, self.checks - first, spend);
         self.checks >= self.budget || self.started.elapsed() >= self.time_limit
     }
 
