@@ -51,7 +51,7 @@ struct DrawnSheet {
 }
 
 /// A spinner on stderr naming the running stage with its time so far, a bar for the
-/// stage that says how far it has got (the nest): only when stderr is a terminal and
+/// stages that say how far they have got (the nest, the sheets' drawing): only when stderr is a terminal and
 /// the job is not `--quiet`, so Make and CI logs stay as they were. Cleared when
 /// dropped, whatever the outcome.
 struct Progress(Option<indicatif::ProgressBar>);
@@ -78,6 +78,7 @@ impl Progress {
             {
                 bar.set_style(style);
             }
+            bar.reset_elapsed();
             bar.set_message(what.to_string());
         }
     }
@@ -93,6 +94,7 @@ impl Progress {
             if let Ok(style) = indicatif::ProgressStyle::with_template(template) {
                 bar.set_style(style.progress_chars("=> "));
             }
+            bar.reset_elapsed();
             bar.set_message(what.to_string());
         }
     }
@@ -464,6 +466,20 @@ pub fn export(
     nested: &Nested,
     warnings: Vec<String>,
 ) -> Result<Exported> {
+    export_observed(job, prepared, output, flat, nested, warnings, &|_| {})
+}
+
+/// [`export`], telling `done` the share of the sheets drawn as each one is.
+pub fn export_observed(
+    job: &Job,
+    prepared: &Prepared,
+    output: &SchemeOutput,
+    flat: &Flat,
+    nested: &Nested,
+    warnings: Vec<String>,
+    done: &(dyn Fn(f64) + Sync),
+) -> Result<Exported> {
+    let drawn_sheets = std::sync::atomic::AtomicUsize::new(0);
     let layout = &nested.layout;
     let panels = &flat.panels;
     let name = job
@@ -521,6 +537,8 @@ pub fn export(
                 lengths: manifest::Lengths::of(&lengths),
                 time_s: round4(job.speeds.seconds(&lengths)),
             };
+            let count = drawn_sheets.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+            done(count as f64 / layout.sheets as f64);
             DrawnSheet {
                 files: sheet_files,
                 lengths,
@@ -638,7 +656,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let nested = nest_observed(job, &flat, &|done| progress.set(done))?;
     progress.set(1.0);
     clock.lap("nest");
-    progress.stage(&format!("writing {} sheets", nested.layout.sheets));
+    progress.bar(&format!("writing {} sheets", nested.layout.sheets));
     let warnings: Vec<String> = prepared
         .warnings
         .iter()
@@ -646,7 +664,10 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         .chain(&flat.warning)
         .cloned()
         .collect();
-    let Exported { files, manifest } = export(job, &prepared, &output, &flat, &nested, warnings)?;
+    let Exported { files, manifest } =
+        export_observed(job, &prepared, &output, &flat, &nested, warnings, &|done| {
+            progress.set(done)
+        })?;
     let mut notes = prepared.notes.clone();
     notes.extend(output.notes.iter().cloned());
     notes.extend(flat.notes.iter().cloned());

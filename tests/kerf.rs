@@ -346,10 +346,15 @@ fn a_kerf_the_holes_cannot_take_is_refused() {
 }
 
 #[test]
-fn net_islands_of_a_shared_model_grow_by_their_perimeter() {
-    let Some(dir) = shared_models("net_islands_of_a_shared_model_grow_by_their_perimeter") else {
+fn shared_models_grow_by_their_perimeter() {
+    let Some(dir) = shared_models("shared_models_grow_by_their_perimeter") else {
         return;
     };
+    // A shared model with holes: the libigl cube's 18 edges, quad-edge.
+    let m = check_kerf("cube", "quad-edge", &dir.join("cube.obj"), "1ft", 2);
+    eprintln!("{m:?}");
+    assert_eq!((m.panels, m.narrow_length), (18, 0.0), "{m:?}");
+    assert!(m.holes > 0 && m.worst_growth < 0.01, "{m:?}");
     let knight = dir.join("decimated-knight.off");
     let m = check_kerf("knight", "net", &knight, "2ft", 0);
     eprintln!("{m:?}");
