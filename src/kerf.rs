@@ -25,7 +25,7 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 
 use crate::panel::{fill_arena, Arena, FlatPanel, FlatPanelRef, FlatPanels, Loops};
-use crate::plane::signed_area;
+use crate::plane::{perimeter, signed_area};
 
 /// Corners sharper than this (radians, inside angle) are bevelled instead of mitred:
 /// the miter of a needle tip would reach far past the part for no gain.
@@ -36,9 +36,9 @@ const MITER_MIN_ANGLE: f64 = std::f64::consts::PI / 12.0;
 const SLIVER: f64 = 1e-3;
 
 /// A gap the closing fills counts as narrower than the kerf when its perimeter passes
-/// this many kerfs: a smaller one is the fillet a
-/// round beam leaves in an inside corner (a right angle's is under 2 kerfs round), or
-/// the last few tenths of a millimetre of a notch, which the material tears through.
+/// this many kerfs: a smaller one is the fillet a round beam leaves in an inside corner
+/// (a right angle's is under 2 kerfs round), or the last few tenths of a millimetre of
+/// a notch, which the material tears through.
 const GAP_MIN_PERIMETER: f64 = 4.0;
 
 /// Corners closer together than this (mm) are merged, and a contour that folds back on
@@ -208,12 +208,6 @@ fn vec2([x, y]: [f64; 2]) -> DVec2 {
     DVec2::new(x, y)
 }
 
-fn perimeter(poly: &[DVec2]) -> f64 {
-    (0..poly.len())
-        .map(|i| poly[i].distance(poly[(i + 1) % poly.len()]))
-        .sum()
-}
-
 /// `shapes` grown by `by` mm (shrunk when `by` < 0), corners joined by `join`.
 fn offset(shapes: &Shapes, by: f64, join: LineJoin<f64>) -> Shapes {
     let mut style = OutlineStyle::new(by);
@@ -225,6 +219,7 @@ fn offset(shapes: &Shapes, by: f64, join: LineJoin<f64>) -> Shapes {
 mod tests {
     use super::*;
     use crate::panel::{FlatHole, Source};
+    use crate::plane::distance_to_border;
 
     /// A 100 x 100 mm L-shaped panel with a square inner cut and a hole.
     fn l_panel() -> FlatPanel {
@@ -265,16 +260,7 @@ mod tests {
     fn to_cut(flat: &FlatPanel, p: DVec2) -> f64 {
         flat.outline
             .iter()
-            .map(|lp| {
-                let c = flat.loop_points(lp);
-                (0..c.len())
-                    .map(|i| {
-                        let (a, b) = (c[i], c[(i + 1) % c.len()]);
-                        let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-                        p.distance(a + t * (b - a))
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            })
+            .map(|lp| distance_to_border(&flat.loop_points(lp), p))
             .fold(f64::INFINITY, f64::min)
     }
 

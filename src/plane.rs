@@ -89,6 +89,13 @@ pub fn contains(poly: &[DVec2], p: DVec2) -> bool {
     inside
 }
 
+/// Length of a closed polygon's border.
+pub fn perimeter(poly: &[DVec2]) -> f64 {
+    (0..poly.len())
+        .map(|i| poly[i].distance(poly[(i + 1) % poly.len()]))
+        .sum()
+}
+
 /// Distance from a point to a segment.
 pub fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;

@@ -51,9 +51,9 @@ struct DrawnSheet {
 }
 
 /// A spinner on stderr naming the running stage with its time so far, a bar for the
-/// stages that say how far they have got (the nest, the sheets' drawing): only when stderr is a terminal and
-/// the job is not `--quiet`, so Make and CI logs stay as they were. Cleared when
-/// dropped, whatever the outcome.
+/// stages that say how far they have got (the nest, the sheets' drawing): only when
+/// stderr is a terminal and the job is not `--quiet`, so Make and CI logs stay as they
+/// were. Cleared when dropped, whatever the outcome.
 struct Progress(Option<indicatif::ProgressBar>);
 
 /// Steps of a progress bar.
@@ -397,13 +397,9 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
     })
 }
 
-/// Stage 5, nest: lays the flat panels out on sheets.
-pub fn nest(job: &Job, flat: &Flat) -> Result<Nested> {
-    nest_observed(job, flat, &|_| {})
-}
-
-/// [`nest`], telling `done` the fraction of the search done each time it grows.
-pub fn nest_observed(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Nested> {
+/// Stage 5, nest: lays the flat panels out on sheets, telling `done` the fraction of
+/// the search done each time it grows.
+pub fn nest(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Nested> {
     let flat = &flat.panels;
     let sheet = SheetSpec {
         width: job.sheet.width,
@@ -456,21 +452,10 @@ pub struct Exported {
     pub manifest: Manifest,
 }
 
-/// Stage 6, export: draws every sheet in every format and builds the manifest: the
-/// output folder's files, which [`run_observed`] writes.
+/// Stage 6, export: draws every sheet in every format, telling `done` the share of the
+/// sheets drawn as each one is, and builds the manifest: the output folder's files,
+/// which [`run_observed`] writes.
 pub fn export(
-    job: &Job,
-    prepared: &Prepared,
-    output: &SchemeOutput,
-    flat: &Flat,
-    nested: &Nested,
-    warnings: Vec<String>,
-) -> Result<Exported> {
-    export_observed(job, prepared, output, flat, nested, warnings, &|_| {})
-}
-
-/// [`export`], telling `done` the share of the sheets drawn as each one is.
-pub fn export_observed(
     job: &Job,
     prepared: &Prepared,
     output: &SchemeOutput,
@@ -653,7 +638,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     crate::sanity::refuse_unfastened(job, fastening.as_ref())?;
     clock.lap("flatten");
     progress.bar(&format!("nesting {} panels on sheets", flat.panels.len()));
-    let nested = nest_observed(job, &flat, &|done| progress.set(done))?;
+    let nested = nest(job, &flat, &|done| progress.set(done))?;
     progress.set(1.0);
     clock.lap("nest");
     progress.bar(&format!("writing {} sheets", nested.layout.sheets));
@@ -665,7 +650,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         .cloned()
         .collect();
     let Exported { files, manifest } =
-        export_observed(job, &prepared, &output, &flat, &nested, warnings, &|done| {
+        export(job, &prepared, &output, &flat, &nested, warnings, &|done| {
             progress.set(done)
         })?;
     let mut notes = prepared.notes.clone();

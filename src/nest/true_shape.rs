@@ -550,6 +550,12 @@ impl<'a> Nester<'a> {
         self.budget_share = (before, weight, self.checks, spend);
     }
 
+    /// Tells the progress display that the construction has placed `placed` parts.
+    fn report_construction(&self, placed: usize) {
+        let of = self.parts.len() as u64;
+        self.report(0, CONSTRUCTION_SHARE, placed as u64, of);
+    }
+
     /// Tells the progress display that this search has done `done` of `of` parts of
     /// a phase worth `weight` thousandths, after `before` thousandths.
     fn report(&self, before: u32, weight: u32, done: u64, of: u64) {
@@ -617,7 +623,7 @@ impl<'a> Nester<'a> {
             if !self.place_anywhere(p) {
                 return Err(p);
             }
-            self.report(0, CONSTRUCTION_SHARE, k as u64 + 1, order.len() as u64);
+            self.report_construction(k + 1);
         }
         Ok(())
     }

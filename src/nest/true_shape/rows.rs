@@ -98,8 +98,7 @@ impl Nester<'_> {
                 Some((i, rest)) => {
                     let part = left.remove(i);
                     self.put(s, part, rest.pose);
-                    let placed = (parts.len() - left.len()) as u64;
-                    self.report(0, super::CONSTRUCTION_SHARE, placed, parts.len() as u64);
+                    self.report_construction(parts.len() - left.len());
                     if row.height == 0.0 {
                         row.height = rest.height;
                         row.floor = rest.bottom;
@@ -114,6 +113,7 @@ impl Nester<'_> {
                     let pose = self.search(s, part, self.samples.max(64)).ok_or(part)?;
                     self.put(s, part, pose);
                     left.remove(0);
+                    self.report_construction(parts.len() - left.len());
                 }
                 None => {
                     s = self.open_sheet();
