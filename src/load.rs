@@ -70,8 +70,8 @@ pub fn load_model(
                 "simplified from {} faces and {} edges to {} faces and {} edges ({}; longest edge {:.1} times the median, 95 % within {:.2}){}; deviation from the original surface {:.3e} model units at most, {:.3e} on average (measured at every original vertex and triangle centre)",
                 report.before.0, report.before.1, report.after.0, report.after.1, mode,
                 report.edge_spread, report.edge_spread_95,
-                if report.relaxed_moves > 0 {
-                    format!("; vertices relaxed toward even edges in {} moves, without increasing the largest or mean deviation", report.relaxed_moves)
+                if report.relaxed_moves + report.relaxed_flips > 0 {
+                    format!("; vertices relaxed toward even edges in {} moves and {} edge flips toward rounder triangles, without increasing the largest or mean deviation", report.relaxed_moves, report.relaxed_flips)
                 } else {
                     String::new()
                 },

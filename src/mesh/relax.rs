@@ -11,6 +11,11 @@
 //!   before relaxing;
 //! - the sum of the samples' distances stays at most what it was before relaxing.
 //!
+//! After each round of moves, an edge whose two triangles gain in their smallest angle
+//! by the other diagonal is flipped, under the same bounds, where the two bend less
+//! than 20° (a sharper crease stays where it is): a cap (one angle near 180°) is a
+//! face whose fastener holes have no room, and moving vertices cannot round it out.
+//!
 //! So the largest and the mean deviation never grow: a move that takes the mesh away
 //! from the surface in one place is paid for by moves that brought it closer
 //! elsewhere. Each sample's distance is tracked to one face: its nearest when
@@ -20,9 +25,11 @@
 //!
 //! Why: every edge becomes a panel, and panels of one size nest tighter and hold
 //! fastener holes more evenly. On the bunny at 625 edges (quad-edge, 4 ft) the edge
-//! at the 95th percentile goes from 1.64 to 1.44 times the median, the last of 12
-//! sheets from 52 % to 16 % full, and the connections' holes from 636 to 796, for
-//! about 0.25 s.
+//! at the 95th percentile goes from 1.64 to 1.42 times the median, for about 0.25 s;
+//! at 1000 edges the flips alone take the face corners without room for a 1/8 in
+//! fastener from 11 to 6 on horse_quad and from 4 to none on fertility.
+
+use std::collections::HashMap;
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -38,6 +45,14 @@ const STEP: f64 = 0.5;
 /// Least share of its area a face around a moved vertex must keep.
 const KEPT_AREA: f64 = 0.1;
 
+/// Least gain in the smallest angle of two triangles (radians) for which their
+/// shared edge is flipped: a flip must be worth the deviation it may cost.
+const FLIP_GAIN: f64 = 0.02;
+
+/// Most bend between two triangles (cosine of the angle between their normals) whose
+/// shared edge may flip: a flip across a sharper crease would move the crease.
+const FLIP_FLATNESS: f64 = 0.94;
+
 /// The original surface that relaxation keeps close to: its triangles (in a grid,
 /// for projecting moved vertices onto it) and the samples its closeness is measured
 /// at.
@@ -46,20 +61,28 @@ pub struct Surface<'a> {
     pub samples: &'a [DVec3],
 }
 
+/// What a relaxation did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Relaxed {
+    /// Vertex moves kept.
+    pub moves: usize,
+    /// Edges flipped.
+    pub flips: usize,
+}
+
 /// Relaxes the vertices `positions` of the triangles `triangles` (consistently
-/// oriented, manifold) toward `surface` (see the module documentation). Deterministic:
-/// vertices move one at a time in index order. Returns the number of moves kept.
-pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface) -> usize {
-    let mut moves = 0;
+/// oriented, manifold) toward `surface` (see the module documentation), flipping the
+/// edges whose two triangles gain in their smallest angle. Deterministic: vertices
+/// move one at a time in index order, edges flip in face order.
+pub fn relax(positions: &mut [DVec3], triangles: &mut [[u32; 3]], surface: &Surface) -> Relaxed {
+    let mut done = Relaxed::default();
     if triangles.is_empty() {
-        return moves;
+        return done;
     }
-    let rings = Rings::new(positions.len(), triangles);
-    // Every face's area vector before relaxing: a face may never turn more than a
-    // quarter turn from it, nor shrink below a tenth of it, however many moves it
-    // takes part in.
-    let area = |[a, b, c]: [DVec3; 3]| (b - a).cross(c - a);
-    let initial_area: Vec<DVec3> = triangles
+    // Every face's area vector before relaxing (or when it was made by a flip): a
+    // face may never turn more than a quarter turn from it, nor shrink below a tenth
+    // of it, however many moves it takes part in.
+    let mut initial_area: Vec<DVec3> = triangles
         .iter()
         .map(|t| area(t.map(|v| positions[v as usize])))
         .collect();
@@ -69,10 +92,9 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
     // first, then, as vertices move a little per round, among the face it was nearest
     // before and that face's neighbours across its edges. (A sample may then keep a
     // face that is no longer its nearest: its tracked distance only overstates.)
-    let corners_of = |f: usize, positions: &[DVec3]| triangles[f].map(|v| positions[v as usize]);
     let mut nearest: Vec<(usize, f64)> = {
         let corners: Vec<[DVec3; 3]> = (0..triangles.len())
-            .map(|f| corners_of(f, positions))
+            .map(|f| corners_of(triangles, f, positions))
             .collect();
         let grid = TriangleGrid::new(&corners);
         surface
@@ -84,10 +106,12 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
             })
             .collect()
     };
-    let around = rings.faces_around_faces();
     for round in 0..ROUNDS {
+        let rings = Rings::new(positions.len(), triangles);
         if round > 0 {
+            let around = rings.faces_around_faces(triangles);
             let fixed: &[DVec3] = positions;
+            let shape: &[[u32; 3]] = triangles;
             nearest = surface
                 .samples
                 .par_iter()
@@ -96,7 +120,7 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
                     around[f]
                         .iter()
                         .map(|&g| {
-                            let [a, b, c] = corners_of(g, fixed);
+                            let [a, b, c] = corners_of(shape, g, fixed);
                             (g, closest_point_on_triangle(p, a, b, c).distance(p))
                         })
                         .min_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)))
@@ -104,71 +128,252 @@ pub fn relax(positions: &mut [DVec3], triangles: &[[u32; 3]], surface: &Surface)
                 })
                 .collect();
         }
-        let mut tracked: Vec<f64> = nearest.iter().map(|n| n.1).collect();
-        let mut total: f64 = tracked.iter().sum();
+        let total: f64 = nearest.iter().map(|n| n.1).sum();
         let (limit, budget) =
-            *bounds.get_or_insert((tracked.iter().copied().fold(0.0, f64::max), total));
-        let samples_of = samples_per_face(triangles.len(), &nearest);
-
-        let mut moved_this_round = 0;
-        for v in 0..positions.len() {
-            let Some(target) = rings.target(v, positions) else {
-                continue;
-            };
-            let Some((_, onto)) = surface.grid.nearest(target) else {
-                continue;
-            };
-            let old = positions[v];
-            if onto.distance(old) <= 1e-12 * (1.0 + old.length()) {
-                continue;
-            }
-            let ring = &rings.faces[v];
-            // The corners of face `f` with vertex `v` at `at`.
-            let posed = |f: usize, at: DVec3| {
-                triangles[f].map(|k| {
-                    if k as usize == v {
-                        at
-                    } else {
-                        positions[k as usize]
-                    }
-                })
-            };
-            let keeps_orientation = ring.iter().all(|&f| {
-                let (before, after) = (initial_area[f], area(posed(f, onto)));
-                after.dot(before) > 0.0 && after.length() >= KEPT_AREA * before.length()
-            });
-            if !keeps_orientation {
-                continue;
-            }
-            // The samples of the faces around the vertex, at their new distances: none
-            // beyond the limit, and their sum within the budget.
-            let mut changed: Vec<(usize, f64)> = Vec::new();
-            let within = ring.iter().all(|&f| {
-                let [a, b, c] = posed(f, onto);
-                samples_of[f].iter().all(|&s| {
-                    let p = surface.samples[s];
-                    let d = closest_point_on_triangle(p, a, b, c).distance(p);
-                    changed.push((s, d));
-                    d <= limit
-                })
-            });
-            let delta: f64 = changed.iter().map(|&(s, d)| d - tracked[s]).sum();
-            if !within || total + delta > budget {
-                continue;
-            }
-            positions[v] = onto;
-            total += delta;
-            for (s, d) in changed {
-                tracked[s] = d;
-            }
-            moved_this_round += 1;
-        }
-        moves += moved_this_round;
-        if moved_this_round == 0 {
+            *bounds.get_or_insert((nearest.iter().map(|n| n.1).fold(0.0, f64::max), total));
+        let mut deviation = Deviation {
+            surface,
+            samples_of: samples_per_face(triangles.len(), &nearest),
+            nearest: &mut nearest,
+            total,
+            limit,
+            budget,
+        };
+        let moved = move_vertices(positions, triangles, &rings, &initial_area, &mut deviation);
+        let flipped = flip_edges(positions, triangles, &mut initial_area, &mut deviation);
+        done.moves += moved;
+        done.flips += flipped;
+        if moved == 0 && flipped == 0 {
             break;
         }
     }
-    moves
+    done
+}
+
+/// The area vector of a triangle.
+fn area([a, b, c]: [DVec3; 3]) -> DVec3 {
+    (b - a).cross(c - a)
+}
+
+/// The corners of face `f`.
+fn corners_of(triangles: &[[u32; 3]], f: usize, positions: &[DVec3]) -> [DVec3; 3] {
+    triangles[f].map(|v| positions[v as usize])
+}
+
+/// A sample measured again: its index, its face and its distance to that face.
+type Remeasured = (usize, usize, f64);
+
+/// The samples' tracked faces and distances within one round, and the bounds on them.
+struct Deviation<'a, 's> {
+    surface: &'a Surface<'s>,
+    /// The samples tracked to each face.
+    samples_of: Vec<Vec<usize>>,
+    nearest: &'a mut [(usize, f64)],
+    /// The sum of the tracked distances.
+    total: f64,
+    limit: f64,
+    budget: f64,
+}
+
+impl Deviation<'_, '_> {
+    /// The samples of `faces` measured again against `triangles` (each against the
+    /// nearest of them): `None` if one would lie beyond the limit, otherwise the new
+    /// (sample, face, distance) and the change in the sum.
+    fn remeasure(
+        &self,
+        faces: &[usize],
+        triangles: &[(usize, [DVec3; 3])],
+    ) -> Option<(Vec<Remeasured>, f64)> {
+        let mut changed = Vec::new();
+        let mut delta = 0.0;
+        for &f in faces {
+            for &s in &self.samples_of[f] {
+                let p = self.surface.samples[s];
+                let (g, d) = triangles
+                    .iter()
+                    .map(|&(g, [a, b, c])| (g, closest_point_on_triangle(p, a, b, c).distance(p)))
+                    .min_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)))?;
+                if d > self.limit {
+                    return None;
+                }
+                delta += d - self.nearest[s].1;
+                changed.push((s, g, d));
+            }
+        }
+        Some((changed, delta))
+    }
+
+    /// Whether a change of `delta` in the sum keeps it within the budget.
+    fn affords(&self, delta: f64) -> bool {
+        self.total + delta <= self.budget
+    }
+
+    /// Keeps what [`Deviation::remeasure`] found.
+    fn keep(&mut self, changed: Vec<Remeasured>, delta: f64) {
+        self.total += delta;
+        for (s, g, d) in changed {
+            let was = self.nearest[s].0;
+            if was != g {
+                self.samples_of[was].retain(|&x| x != s);
+                let at = self.samples_of[g].partition_point(|&x| x < s);
+                self.samples_of[g].insert(at, s);
+            }
+            self.nearest[s] = (g, d);
+        }
+    }
+}
+
+/// One sweep of vertex moves (see the module documentation); returns how many were
+/// kept.
+fn move_vertices(
+    positions: &mut [DVec3],
+    triangles: &[[u32; 3]],
+    rings: &Rings,
+    initial_area: &[DVec3],
+    deviation: &mut Deviation,
+) -> usize {
+    let mut moved = 0;
+    for v in 0..positions.len() {
+        let Some(target) = rings.target(v, positions, triangles) else {
+            continue;
+        };
+        let Some((_, onto)) = deviation.surface.grid.nearest(target) else {
+            continue;
+        };
+        let old = positions[v];
+        if onto.distance(old) <= 1e-12 * (1.0 + old.length()) {
+            continue;
+        }
+        let ring = &rings.faces[v];
+        // The corners of face `f` with vertex `v` at `at`.
+        let posed = |f: usize, at: DVec3| {
+            triangles[f].map(|k| {
+                if k as usize == v {
+                    at
+                } else {
+                    positions[k as usize]
+                }
+            })
+        };
+        let keeps_orientation = ring.iter().all(|&f| {
+            let (before, after) = (initial_area[f], area(posed(f, onto)));
+            after.dot(before) > 0.0 && after.length() >= KEPT_AREA * before.length()
+        });
+        if !keeps_orientation {
+            continue;
+        }
+        // The samples of the faces around the vertex, each against its own face
+        // moved: none beyond the limit, and their sum within the budget.
+        let kept = ring
+            .iter()
+            .try_fold((Vec::new(), 0.0), |(mut all, sum), &f| {
+                let (changed, delta) = deviation.remeasure(&[f], &[(f, posed(f, onto))])?;
+                all.extend(changed);
+                Some((all, sum + delta))
+            });
+        let Some((changed, delta)) = kept else {
+            continue;
+        };
+        if !deviation.affords(delta) {
+            continue;
+        }
+        positions[v] = onto;
+        deviation.keep(changed, delta);
+        moved += 1;
+    }
+    moved
+}
+
+/// The smallest angle of a triangle, in radians.
+fn smallest_angle([a, b, c]: [DVec3; 3]) -> f64 {
+    let at = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p);
+    at(a, b, c).min(at(b, c, a)).min(at(c, a, b))
+}
+
+/// One sweep of edge flips, in face order: the edge between triangles (a, b, c) and
+/// (b, a, d) becomes (c, d) where that gains [`FLIP_GAIN`] in the smallest angle of
+/// the two, the two bend less than [`FLIP_FLATNESS`] allows, both new triangles face
+/// the way the old ones did, c and d are not joined already, and the samples of the
+/// two keep within the bounds. Returns how many flipped.
+fn flip_edges(
+    positions: &[DVec3],
+    triangles: &mut [[u32; 3]],
+    initial_area: &mut [DVec3],
+    deviation: &mut Deviation,
+) -> usize {
+    // Each edge's faces (a border or non-manifold edge holds other than two).
+    let mut faces_of: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    for (f, t) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            faces_of
+                .entry(key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(f);
+        }
+    }
+    let mut flipped = 0;
+    for f in 0..triangles.len() {
+        for k in 0..3 {
+            let t = triangles[f];
+            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let g = match faces_of.get(&key(a, b)).map(Vec::as_slice) {
+                Some(&[x, y]) => {
+                    if x == f {
+                        y
+                    } else {
+                        x
+                    }
+                }
+                _ => continue,
+            };
+            let u = triangles[g];
+            let Some(j) = (0..3).find(|&j| u[j] == b && u[(j + 1) % 3] == a) else {
+                continue;
+            };
+            let d = u[(j + 2) % 3];
+            if c == d || faces_of.contains_key(&key(c, d)) {
+                continue;
+            }
+            let p = |v: u32| positions[v as usize];
+            let (old1, old2) = ([p(a), p(b), p(c)], [p(b), p(a), p(d)]);
+            let (new1, new2) = ([p(a), p(d), p(c)], [p(d), p(b), p(c)]);
+            let gain = smallest_angle(new1).min(smallest_angle(new2))
+                - smallest_angle(old1).min(smallest_angle(old2));
+            let (n1, n2) = (area(old1), area(old2));
+            let normal = n1 + n2;
+            let flat = n1.normalize_or_zero().dot(n2.normalize_or_zero()) >= FLIP_FLATNESS;
+            if gain < FLIP_GAIN
+                || !flat
+                || area(new1).dot(normal) <= 0.0
+                || area(new2).dot(normal) <= 0.0
+            {
+                continue;
+            }
+            let Some((changed, delta)) = deviation
+                .remeasure(&[f, g], &[(f, new1), (g, new2)])
+                .filter(|(_, delta)| deviation.affords(*delta))
+            else {
+                continue;
+            };
+            deviation.keep(changed, delta);
+            triangles[f] = [a, d, c];
+            triangles[g] = [d, b, c];
+            initial_area[f] = area(new1);
+            initial_area[g] = area(new2);
+            faces_of.remove(&key(a, b));
+            faces_of.insert(key(c, d), vec![f, g]);
+            for (edge, from, to) in [(key(a, d), g, f), (key(b, c), f, g)] {
+                if let Some(list) = faces_of.get_mut(&edge) {
+                    for x in list.iter_mut().filter(|x| **x == from) {
+                        *x = to;
+                    }
+                }
+            }
+            flipped += 1;
+        }
+    }
+    flipped
 }
 
 /// Whether the faces `fan` around an interior vertex `v` form a single closed fan:
@@ -211,15 +416,14 @@ fn samples_per_face(faces: usize, nearest: &[(usize, f64)]) -> Vec<Vec<usize>> {
 
 /// What each vertex's move needs of the connectivity: its faces, its neighbours, and
 /// whether it may move at all (not on a border, not at a non-manifold edge).
-struct Rings<'a> {
-    triangles: &'a [[u32; 3]],
+struct Rings {
     faces: Vec<Vec<usize>>,
     neighbours: Vec<Vec<u32>>,
     movable: Vec<bool>,
 }
 
-impl<'a> Rings<'a> {
-    fn new(vertices: usize, triangles: &'a [[u32; 3]]) -> Self {
+impl Rings {
+    fn new(vertices: usize, triangles: &[[u32; 3]]) -> Self {
         let mut faces = vec![Vec::new(); vertices];
         let mut edges: Vec<(u32, u32)> = Vec::with_capacity(3 * triangles.len());
         for (f, t) in triangles.iter().enumerate() {
@@ -251,7 +455,6 @@ impl<'a> Rings<'a> {
             }
         }
         Rings {
-            triangles,
             faces,
             neighbours,
             movable,
@@ -260,8 +463,8 @@ impl<'a> Rings<'a> {
 
     /// For every face, the faces that share an edge with it (itself included), in
     /// index order.
-    fn faces_around_faces(&self) -> Vec<Vec<usize>> {
-        self.triangles
+    fn faces_around_faces(&self, triangles: &[[u32; 3]]) -> Vec<Vec<usize>> {
+        triangles
             .iter()
             .enumerate()
             .map(|(f, t)| {
@@ -285,7 +488,7 @@ impl<'a> Rings<'a> {
     /// Where vertex `v` would move before projection: `STEP` of the way to the
     /// centroid of its neighbours, within its tangent plane (normal: the sum of its
     /// faces' area vectors). `None` for a pinned vertex or an undefined normal.
-    fn target(&self, v: usize, positions: &[DVec3]) -> Option<DVec3> {
+    fn target(&self, v: usize, positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<DVec3> {
         if !self.movable[v] || self.neighbours[v].is_empty() {
             return None;
         }
@@ -295,19 +498,16 @@ impl<'a> Rings<'a> {
             .map(|&u| positions[u as usize])
             .sum::<DVec3>()
             / self.neighbours[v].len() as f64;
-        let normal = self.normal(v, positions)?;
+        let normal = self.normal(v, positions, triangles)?;
         let d = centroid - p;
         Some(p + STEP * (d - d.dot(normal) * normal))
     }
 
     /// The unit sum of the area vectors of the faces around `v`.
-    fn normal(&self, v: usize, positions: &[DVec3]) -> Option<DVec3> {
+    fn normal(&self, v: usize, positions: &[DVec3], triangles: &[[u32; 3]]) -> Option<DVec3> {
         let sum: DVec3 = self.faces[v]
             .iter()
-            .map(|&f| {
-                let [a, b, c] = self.triangles[f].map(|k| positions[k as usize]);
-                (b - a).cross(c - a)
-            })
+            .map(|&f| area(corners_of(triangles, f, positions)))
             .sum();
         sum.try_normalize()
     }
@@ -407,13 +607,14 @@ mod tests {
             grid: &grid,
             samples: &samples,
         };
-        let moves = relax(&mut relaxed, &faces, &surface);
+        let mut flipped = faces.clone();
+        let done = relax(&mut relaxed, &mut flipped, &surface);
         let after = (
-            deviation(&samples, &relaxed, &faces),
-            spread(&relaxed, &faces),
+            deviation(&samples, &relaxed, &flipped),
+            spread(&relaxed, &flipped),
         );
 
-        assert!(moves > 0, "nothing moved");
+        assert!(done.moves > 0, "nothing moved");
         assert!(
             after.1 < 0.9 * before.1,
             "edges did not even out: longest/shortest {:.3} -> {:.3}",
@@ -430,7 +631,7 @@ mod tests {
             "mean deviation grew: {sum_before:e} -> {sum_after:e}"
         );
         // Every face still faces out, and every vertex lies on the original surface.
-        for t in &faces {
+        for t in &flipped {
             let [a, b, c] = t.map(|v| relaxed[v as usize]);
             assert!(
                 (b - a).cross(c - a).dot(a + b + c) > 0.0,
@@ -442,8 +643,81 @@ mod tests {
         }
 
         // The same input relaxes to the same positions.
-        let mut again = coarse.clone();
-        relax(&mut again, &faces, &surface);
-        assert_eq!(again, relaxed);
+        let (mut again, mut again_faces) = (coarse.clone(), faces.clone());
+        relax(&mut again, &mut again_faces, &surface);
+        assert_eq!((again, again_faces), (relaxed, flipped));
+    }
+
+    #[test]
+    fn flips_round_out_caps_on_a_flat_surface() {
+        // A patch of the equilateral triangle lattice in the plane z = 0, every
+        // rhombus of two triangles split along its long diagonal: triangles of 30°,
+        // 30° and 120° where the short diagonal would give equilateral ones.
+        let h = 0.75f64.sqrt();
+        let mut positions = Vec::new();
+        for j in 0..5 {
+            for i in 0..5 {
+                positions.push(DVec3::new(i as f64 + 0.5 * j as f64, h * j as f64, 0.0));
+            }
+        }
+        let at = |i: usize, j: usize| (j * 5 + i) as u32;
+        let mut faces = Vec::new();
+        for j in 0..4 {
+            for i in 0..4 {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                faces.extend([[a, b, c], [a, c, d]]);
+            }
+        }
+        let original = corners(&positions, &faces);
+        let grid = TriangleGrid::new(&original);
+        let samples: Vec<DVec3> = original
+            .iter()
+            .map(|[a, b, c]| (*a + *b + *c) / 3.0)
+            .collect();
+        let surface = Surface {
+            grid: &grid,
+            samples: &samples,
+        };
+        let smallest = |positions: &[DVec3], faces: &[[u32; 3]]| {
+            corners(positions, faces)
+                .into_iter()
+                .map(smallest_angle)
+                .fold(f64::INFINITY, f64::min)
+        };
+        let before = smallest(&positions, &faces);
+        let edges = |faces: &[[u32; 3]]| {
+            let mut e: Vec<(u32, u32)> = faces
+                .iter()
+                .flat_map(|t| {
+                    (0..3).map(move |k| (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3])))
+                })
+                .collect();
+            e.sort_unstable();
+            e.dedup();
+            e.len()
+        };
+        let edges_before = edges(&faces);
+        let mut relaxed = positions.clone();
+        let done = relax(&mut relaxed, &mut faces, &surface);
+        // Every flip makes two equilateral triangles. (The samples lie on the mesh, so
+        // the deviation bound is zero and a flip whose samples the rounding puts off
+        // the new triangles is refused: most flip, not all.)
+        let equilateral = corners(&relaxed, &faces)
+            .into_iter()
+            .filter(|&t| smallest_angle(t) > 60f64.to_radians() - 1e-9)
+            .count();
+        assert!(done.flips >= 12, "{done:?}");
+        assert_eq!(equilateral, 2 * done.flips, "{done:?}");
+        assert!(smallest(&relaxed, &faces) >= before - 1e-12);
+        assert_eq!(edges(&faces), edges_before, "a flip changed the edge count");
+        for t in &faces {
+            let [a, b, c] = t.map(|v| relaxed[v as usize]);
+            assert!((b - a).cross(c - a).z > 0.0, "a face turned over");
+        }
+        let total_area: f64 = corners(&relaxed, &faces)
+            .iter()
+            .map(|&t| 0.5 * area(t).length())
+            .sum();
+        assert!((total_area - 16.0 * h).abs() < 1e-9, "area {total_area}");
     }
 }

@@ -59,6 +59,8 @@ pub struct SimplifyReport {
     pub mean_deviation: f64,
     /// Vertex moves kept by the relaxation of regular mode (0 in accurate mode).
     pub relaxed_moves: usize,
+    /// Edges flipped by that relaxation toward rounder triangles.
+    pub relaxed_flips: usize,
     /// The longest edge over the median edge after simplification: how far the
     /// largest panel is from a typical one.
     pub edge_spread: f64,
@@ -178,6 +180,7 @@ pub fn simplify(
                 deviation: 0.0,
                 mean_deviation: 0.0,
                 relaxed_moves: 0,
+                relaxed_flips: 0,
                 edge_spread: spread.0,
                 edge_spread_95: spread.1,
                 fallback: None,
@@ -348,13 +351,16 @@ impl Input<'_> {
         }
         let samples = self.samples;
         let mut relaxed_moves = 0;
+        let mut relaxed_flips = 0;
         let mut measured = deviation(samples, &simplified);
         if let Some(surface) = &self.relax_onto {
             // Relaxing moves vertices only: the connectivity, and so the topology just
             // checked, stay.
-            let triangles: Vec<[u32; 3]> = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
-            let moves = relax(&mut polys.positions, &triangles, surface);
-            if moves > 0 {
+            let mut triangles: Vec<[u32; 3]> = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
+            let mut positions = polys.positions.clone();
+            let relaxed = relax(&mut positions, &mut triangles, surface);
+            if relaxed.moves + relaxed.flips > 0 {
+                let polys = Polygons::from_faces(positions, &triangles);
                 // The relaxation's bounds hold up to the rounding of its running sums
                 // (and of the grid's search): keep its result only if the deviation,
                 // measured again, really did not grow (otherwise the unrelaxed mesh
@@ -366,7 +372,8 @@ impl Input<'_> {
                 if let Some((m, again)) = kept {
                     simplified = m;
                     measured = again;
-                    relaxed_moves = moves;
+                    relaxed_moves = relaxed.moves;
+                    relaxed_flips = relaxed.flips;
                 }
             }
         }
@@ -378,6 +385,7 @@ impl Input<'_> {
             deviation,
             mean_deviation,
             relaxed_moves,
+            relaxed_flips,
             edge_spread: spread.0,
             edge_spread_95: spread.1,
             fallback: None,
