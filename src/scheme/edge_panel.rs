@@ -349,6 +349,134 @@ pub fn place_pins(
     (Vec::new(), true)
 }
 
+/// The gap between two convex polygons (0 where they overlap).
+fn polygon_gap(a: &[DVec2], b: &[DVec2]) -> f64 {
+    if crate::plane::contains(a, b[0]) || crate::plane::contains(b, a[0]) {
+        return 0.0;
+    }
+    let edges = |p: &[DVec2]| {
+        (0..p.len())
+            .map(|i| (p[i], p[(i + 1) % p.len()]))
+            .collect::<Vec<_>>()
+    };
+    let (ea, eb) = (edges(a), edges(b));
+    ea.iter()
+        .flat_map(|&(p, q)| {
+            eb.iter()
+                .map(move |&(r, t)| crate::plane::segment_distance(p, q, r, t))
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Sides of the polygon a notch runs round a pin with: the notch clears the pin by
+/// its full distance everywhere, its corners a little more.
+const NOTCH_SIDES: usize = 16;
+
+/// Flap `flap` (convex, counter-clockwise, starting at the two ends of its fold) with a
+/// notch round each of `pins`, the pins of other corners of its face that it would
+/// otherwise cover or come within `clear` of. Each notch is the band of width
+/// 2·`clear` from its pin straight away from the fold, round at the fold's end, so the
+/// flap keeps one outline without holes. `None` where a notch would come nearer the
+/// fold than `keep` (the flap must stay whole along it) or the flap would not stay
+/// one piece.
+pub fn notch_flap(flap: &[DVec2], pins: &[DVec2], clear: f64, keep: f64) -> Option<Vec<DVec2>> {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::core::overlay_rule::OverlayRule;
+    use i_overlay::core::solver::Solver;
+    use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
+    use i_overlay::mesh::float::outline::offset::OutlineOffset;
+    use i_overlay::mesh::float::style::OutlineStyle;
+
+    let (fold_start, fold_end) = (flap[0], flap[1]);
+    let inward = (fold_end - fold_start).perp().normalize_or_zero();
+    let reach = 4.0
+        * flap
+            .iter()
+            .map(|p| p.distance(fold_start))
+            .fold(clear, f64::max);
+    let radius = clear / (std::f64::consts::PI / NOTCH_SIDES as f64).cos();
+    let mut notches: Vec<Vec<DVec2>> = Vec::with_capacity(pins.len());
+    for &pin in pins {
+        let round: Vec<DVec2> = (0..NOTCH_SIDES)
+            .map(|i| {
+                let angle = std::f64::consts::TAU * (i as f64 + 0.5) / NOTCH_SIDES as f64;
+                pin + radius * DVec2::from_angle(angle)
+            })
+            .collect();
+        let far: Vec<DVec2> = round.iter().map(|&p| p + reach * inward).collect();
+        notches.push(crate::plane::convex_hull(&[round, far].concat()));
+    }
+    // Notches nearer each other than `keep` become one: the flap between them would be
+    // a finger too thin to hold.
+    let mut k = 0;
+    while k < notches.len() {
+        let near = (k + 1..notches.len()).find(|&j| polygon_gap(&notches[k], &notches[j]) < keep);
+        match near {
+            Some(j) => {
+                let other = notches.swap_remove(j);
+                notches[k] = crate::plane::convex_hull(&[notches[k].clone(), other].concat());
+            }
+            None => k += 1,
+        }
+    }
+    for hull in &notches {
+        let near_fold = (0..hull.len()).any(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % hull.len()]);
+            crate::plane::segment_distance(a, b, fold_start, fold_end) < keep
+        });
+        if near_fold || crate::plane::contains(hull, fold_start) {
+            return None;
+        }
+    }
+    let notches: Vec<Vec<[f64; 2]>> = notches
+        .iter()
+        .map(|hull| hull.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let subject: Vec<[f64; 2]> = flap.iter().map(|p| [p.x, p.y]).collect();
+    // OGC-valid: a flap that a notch nearly cuts through comes back as two pieces,
+    // not one outline touching itself.
+    let shapes = FloatOverlay::<[f64; 2], i64>::from_subj_and_clip_custom(
+        &[subject],
+        &notches,
+        OverlayOptions::ogc(),
+        Solver::default(),
+    )
+    .overlay(OverlayRule::Difference, FillRule::NonZero);
+    // A notch may cut off the flap's tip beyond its pin: that piece no longer hangs on
+    // the fold and is left out. The fold's two ends come back exactly, first, as the
+    // flap's other loops have them.
+    let tolerance = 1e-6 * (1.0 + reach);
+    let at_fold = |contour: &Vec<[f64; 2]>| {
+        contour
+            .iter()
+            .position(|&[x, y]| DVec2::new(x, y).distance(fold_start) <= tolerance)
+    };
+    let shape = shapes.iter().find(|shape| at_fold(&shape[0]).is_some())?;
+    let [contour] = shape.as_slice() else {
+        return None;
+    };
+    // Nor may a notch nearly cut through it: shrunk by half of `keep`, the flap stays
+    // one piece, so no part of it hangs on a neck narrower than `keep`.
+    let shrunk = vec![vec![contour.clone()]].outline_as::<i64>(&OutlineStyle::new(-0.5 * keep));
+    if shrunk.len() > 1 {
+        return None;
+    }
+    let mut outline: Vec<DVec2> = contour.iter().map(|&[x, y]| DVec2::new(x, y)).collect();
+    if crate::plane::signed_area(&outline) < 0.0 {
+        outline.reverse();
+    }
+    let start = outline
+        .iter()
+        .position(|p| p.distance(fold_start) <= tolerance)?;
+    outline.rotate_left(start);
+    if outline.len() < 3 || outline[1].distance(fold_end) > tolerance {
+        return None;
+    }
+    outline[0] = fold_start;
+    outline[1] = fold_end;
+    crate::plane::is_simple(&outline).then_some(outline)
+}
+
 /// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
 /// face order), widened where corners need it (`widen_bands`), then the panels, the
 /// connection count (one per face corner) and the report lines.
@@ -672,4 +800,57 @@ fn flap_labels(
         on_edge: false,
         slide: 0.1 * a.distance(b),
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plane::{contains, distance_to_border, is_simple, signed_area};
+
+    /// A flap 40 mm along its fold (the x axis) and 12 mm deep.
+    fn flap() -> Vec<DVec2> {
+        [(0.0, 0.0), (40.0, 0.0), (40.0, 12.0), (0.0, 12.0)]
+            .map(|(x, y)| DVec2::new(x, y))
+            .to_vec()
+    }
+
+    #[test]
+    fn a_notch_clears_the_pin_and_keeps_the_fold() {
+        let (clear, keep) = (3.175, 1.5875);
+        // One pin inside the flap, one past its inner line but within `clear` of it.
+        let pins = [DVec2::new(12.0, 7.0), DVec2::new(30.0, 14.0)];
+        let notched = notch_flap(&flap(), &pins, clear, keep).expect("room for both notches");
+        assert_eq!(
+            (notched[0], notched[1]),
+            (flap()[0], flap()[1]),
+            "the fold first"
+        );
+        assert!(is_simple(&notched) && signed_area(&notched) > 0.0);
+        for pin in pins {
+            assert!(!contains(&notched, pin));
+            assert!(distance_to_border(&notched, pin) >= clear * (1.0 - 1e-9));
+        }
+        // Each notch takes the strip from its pin to the inner line, round at the pin:
+        // less than its bounding box, more than the strip beyond the pin.
+        let taken = signed_area(&flap()) - signed_area(&notched);
+        let boxes = 2.0 * clear * (12.0 - 7.0 + clear) + 2.0 * clear * (12.0 - 14.0 + clear);
+        let strips = 2.0 * clear * (12.0 - 7.0);
+        assert!(taken < boxes * 1.03 && taken > strips, "{taken} mm²");
+    }
+
+    #[test]
+    fn no_notch_reaches_the_fold_and_near_notches_merge() {
+        let (clear, keep) = (3.175, 1.5875);
+        // Too near the fold: the flap would not stay whole along it.
+        assert!(notch_flap(&flap(), &[DVec2::new(20.0, 4.0)], clear, keep).is_none());
+        // Two pins whose notches leave a finger narrower than `keep` between them
+        // become one notch.
+        let pins = [
+            DVec2::new(15.0, 8.0),
+            DVec2::new(15.0 + 2.0 * clear + 0.5, 8.0),
+        ];
+        let merged = notch_flap(&flap(), &pins, clear, keep).expect("one wide notch");
+        let between = DVec2::new(15.0 + clear + 0.25, 10.0);
+        assert!(!contains(&merged, between), "the finger is cut away");
+    }
 }

@@ -20,8 +20,8 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps, WidenFor,
-    EDGE_DEFAULTS,
+    band, corner_half_edges, edge_scheme, notch_flap, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    WidenFor, EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
@@ -86,13 +86,14 @@ pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
 }
 
 /// The deepest a flap grows, in units of its band edge's distance from the face centre
-/// (1 reaches the centre): beyond one and a half, a triangle's flaps cover the third
-/// flap's corners, where its own holes go.
-pub const MAX_FLAP_SCALE: f64 = 1.5;
+/// (1 reaches the centre, 3 a triangle's far corner): beyond one and a half, a
+/// triangle's flaps cover the third flap's corners, and are notched round the pins
+/// there.
+pub const MAX_FLAP_SCALE: f64 = 2.5;
 
 /// Steps from `--flap-scale` to [`MAX_FLAP_SCALE`] tried when a corner's overlap is too
 /// small for its holes.
-const FLAP_STEPS: u32 = 16;
+const FLAP_STEPS: u32 = 32;
 
 /// A face corner's plan: how deep its two flaps go, its label point and its pins.
 #[derive(Clone)]
@@ -208,55 +209,73 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
             .map(|k| corners[k].depth.max(corners[(k + 1) % n].depth))
             .collect()
     };
-    // A pin goes through the two flaps of its corner only: it must stay clear of the
-    // face's other flaps, which grow too in small faces.
+    // A pin goes through the two flaps of its corner only: the face's other flaps,
+    // which grow too in small faces, must stay clear of it, notched round it where
+    // they would not (see `notch_flap`). The flaps of a plan, `None` where a notch
+    // cannot be cut or would come too near a flap's own pins.
     let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
     let apart =
         |pin: DVec2, flap: &[DVec2]| !contains(flap, pin) && distance_to_border(flap, pin) >= clear;
-    let conflicts = |corners: &[Corner]| -> bool {
-        let flaps: Vec<Vec<DVec2>> = flap_depths(corners)
-            .iter()
-            .enumerate()
-            .map(|(j, &d)| flap_at(j, d))
-            .collect();
-        corners.iter().enumerate().any(|(k, c)| {
-            let prev = (k + n - 1) % n;
-            c.pins.iter().any(|&pin| {
-                flaps
-                    .iter()
-                    .enumerate()
-                    .any(|(j, flap)| j != prev && j != k && !apart(pin, flap))
-            })
-        })
-    };
-    // First one pin at every corner that can hold one, with the shallowest flaps; then
-    // corner by corner the wanted count, where the deeper flaps it takes do not cover
-    // another corner's pins.
-    let mut corners: Vec<Corner> = (0..n)
-        .map(|k| {
-            plan(k, panel.holes.min(1)).unwrap_or_else(|| {
-                let (centre, _) = corner_pins(k, depths[0], 0);
-                Corner {
-                    depth: depths[0],
-                    centre,
-                    pins: Vec::new(),
+    let flaps_for = |corners: &[Corner]| -> Option<Vec<Vec<DVec2>>> {
+        let depths = flap_depths(corners);
+        (0..n)
+            .map(|j| {
+                let flap = flap_at(j, depths[j]);
+                let own = [j, (j + 1) % n];
+                let foreign: Vec<DVec2> = (0..n)
+                    .filter(|k| !own.contains(k))
+                    .flat_map(|k| corners[k].pins.iter().copied())
+                    .filter(|&pin| !apart(pin, &flap))
+                    .collect();
+                if foreign.is_empty() {
+                    return Some(flap);
                 }
+                let notched = notch_flap(&flap, &foreign, clear, panel.hole_margin)?;
+                let holds_own = own.iter().flat_map(|&k| &corners[k].pins).all(|&pin| {
+                    contains(&notched, pin) && distance_to_border(&notched, pin) >= clear
+                });
+                holds_own.then_some(notched)
             })
-        })
+            .collect()
+    };
+    // First one pin at every corner that can hold one, with the shallowest flaps;
+    // where those clash, corner by corner in order, each kept only if the flaps can
+    // still be cut with it (a corner left without keeps the shallowest flaps). Then
+    // corner by corner the wanted count, where the deeper flaps it takes still can.
+    let bare_corner = |k: usize| {
+        let (centre, _) = corner_pins(k, depths[0], 0);
+        Corner {
+            depth: depths[0],
+            centre,
+            pins: Vec::new(),
+        }
+    };
+    let planned: Vec<Corner> = (0..n)
+        .map(|k| plan(k, panel.holes.min(1)).unwrap_or_else(|| bare_corner(k)))
         .collect();
+    let mut corners = planned.clone();
+    if flaps_for(&corners).is_none() {
+        corners = (0..n).map(bare_corner).collect();
+        for (k, corner) in planned.into_iter().enumerate() {
+            let mut tried = corners.clone();
+            tried[k] = corner;
+            if flaps_for(&tried).is_some() {
+                corners = tried;
+            }
+        }
+    }
     if panel.holes > 1 {
         for k in 0..n {
             if let Some(full) = plan(k, panel.holes) {
                 let mut tried = corners.clone();
                 tried[k] = full;
-                if !conflicts(&tried) {
+                if flaps_for(&tried).is_some() {
                     corners = tried;
                 }
             }
         }
     }
-    let depth_of = flap_depths(&corners);
-    let flaps: Vec<Vec<DVec2>> = (0..n).map(|k| flap_at(k, depth_of[k])).collect();
+    let flaps = flaps_for(&corners).expect("every step above kept flaps that can be cut");
 
     let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
     for flap in &flaps {
@@ -266,16 +285,7 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
         let prev = (k + n - 1) % n;
         parts.set_corner_label(k, frame.to3(corner.centre));
         parts.grown += usize::from(corner.depth > options.flap_scale);
-        let pins: Vec<DVec2> = corner
-            .pins
-            .into_iter()
-            .filter(|&pin| {
-                flaps
-                    .iter()
-                    .enumerate()
-                    .all(|(j, flap)| j == prev || j == k || apart(pin, flap))
-            })
-            .collect();
+        let pins = corner.pins;
         parts.reduced += usize::from((pins.len() as u32) < panel.holes);
         // The connection at corner k is named by the half-edge leaving it; both flaps
         // meeting there carry its holes.

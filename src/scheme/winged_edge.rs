@@ -115,13 +115,51 @@ pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
     })
 }
 
+/// The deepest the flaps and wings of a face grow, as a fraction of the way from the
+/// band to the face centre: the inner polygon keeps a little of the face round the
+/// centre, so the sectors stay four-sided.
+const MAX_FLAP_SCALE: f64 = 0.9;
+
+/// Steps from `--flap-scale` to [`MAX_FLAP_SCALE`] tried for a face whose corners hold
+/// fewer holes than wanted.
+const FLAP_STEPS: u32 = 8;
+
+/// A face's flaps and wings at `--flap-scale`, or, where its corners hold fewer holes
+/// than wanted there, at the shallowest deeper scale that holds the most (the face's
+/// sectors all grow together, so they still tile the ring between band and inner
+/// polygon).
 fn face_flaps(mesh: &Mesh, f: FaceId, options: &EdgeOptions, shift: i32) -> FaceFlaps {
+    let shortfall = |flaps: &FaceFlaps| (flaps.bare.len(), flaps.reduced);
+    let mut best = face_flaps_at(mesh, f, options, shift, options.flap_scale);
+    let from = options.flap_scale;
+    for i in 1..=FLAP_STEPS {
+        if shortfall(&best) == (0, 0) || from >= MAX_FLAP_SCALE {
+            break;
+        }
+        let depth = from + (MAX_FLAP_SCALE - from) * f64::from(i) / f64::from(FLAP_STEPS);
+        let mut tried = face_flaps_at(mesh, f, options, shift, depth);
+        if shortfall(&tried) < shortfall(&best) {
+            tried.grown = tried.corners();
+            best = tried;
+        }
+    }
+    best
+}
+
+/// A face's flaps and wings with the inner polygon at `flap_scale`.
+fn face_flaps_at(
+    mesh: &Mesh,
+    f: FaceId,
+    options: &EdgeOptions,
+    shift: i32,
+    flap_scale: f64,
+) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
     let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
     let at = |k: usize| b[k % n];
     // Inner corners (the centre is the frame's origin) and edge midpoints.
-    let inner = |k: usize| (1.0 - options.flap_scale) * at(k);
+    let inner = |k: usize| (1.0 - flap_scale) * at(k);
     let mid = |k: usize| 0.5 * (at(k) + at(k + 1));
     let inner_mid = |k: usize| 0.5 * (inner(k) + inner(k + 1));
 
