@@ -188,6 +188,98 @@ fn segment_crosses_triangle(p: DVec3, q: DVec3, t: [DVec3; 3]) -> bool {
     v > 1e-7 && w > 1e-7 && 1.0 - v - w > 1e-7
 }
 
+/// A lap joint without a hole is an unfastened connection like any other: the
+/// scheme lists it (the two segments, the vertex of its corner), the manifest counts
+/// it under 0 holes, the build warns, and `--strict` refuses it without writing
+/// anything. At 1 ft the 6 × 4 torus holds both holes at every joint; at 180 mm the
+/// strands of its inner corners are too narrow for a 1/8 in hole.
+#[test]
+fn lap_joints_without_a_hole_are_unfastened() {
+    let tmp = TempDir::new().unwrap();
+    let fastened = woven_job("torus-6x4", "1ft", tmp.path());
+    let p = pipeline(&fastened);
+    assert!(p.output.unfastened.is_empty(), "{:?}", p.output.unfastened);
+    let m = build(
+        "woven",
+        &model("torus-6x4"),
+        "1ft",
+        &tmp.path().join("1ft"),
+        &[],
+    );
+    let joints = count(&m, "counts.connections");
+    assert_eq!(
+        m["counts"]["connections_by_holes"],
+        serde_json::json!({ "2": joints })
+    );
+
+    let narrow = woven_job("torus-6x4", "180mm", tmp.path());
+    let p = pipeline(&narrow);
+    let bare = &p.output.unfastened;
+    let out = tmp.path().join("180mm");
+    let m = build("woven", &model("torus-6x4"), "180mm", &out, &[]);
+    let by_holes = &m["counts"]["connections_by_holes"];
+    assert!(!bare.is_empty() && bare.len() < joints, "{bare:?}");
+    assert_eq!(count(by_holes, "0"), bare.len(), "{by_holes}");
+    // The holes the joints do have are in pairs on the two segments' panels.
+    let holes: usize = p.flat.iter().map(|f| f.holes.len()).sum();
+    assert_eq!(holes, count(&m, "counts.holes"));
+    assert_eq!(
+        holes,
+        2 * 2 * count(by_holes, "2") + 2 * by_holes["1"].as_u64().unwrap_or(0) as usize
+    );
+    let segments: std::collections::BTreeSet<String> =
+        p.flat.iter().map(|f| f.id().to_string()).collect();
+    for c in bare {
+        for panel in &c.panels {
+            assert!(
+                segments.contains(&panel.to_string()),
+                "{c}: no panel {panel}"
+            );
+        }
+        assert!(c.at.to_string().starts_with('V'), "{c}");
+        // The two segments share that joint (and the other one too when they are all
+        // of their cycle): no hole of theirs goes through both but the other's.
+        let ids = |name: &unfold::panel::Name| -> std::collections::BTreeSet<u32> {
+            let flat = p
+                .flat
+                .iter()
+                .find(|f| f.id().to_string() == name.to_string());
+            flat.into_iter()
+                .flat_map(|f| &f.holes)
+                .map(|h| h.connection)
+                .collect()
+        };
+        let shared = ids(&c.panels[0]).intersection(&ids(&c.panels[1])).count();
+        let cycle = c.panels[0].to_string();
+        let cycle = cycle.split('.').next().unwrap();
+        let of_cycle = segments
+            .iter()
+            .filter(|s| s.split('.').next() == Some(cycle))
+            .count();
+        assert!(
+            shared < if of_cycle == 2 { 2 } else { 1 },
+            "{c}: {shared} shared joints hold holes"
+        );
+    }
+    let warnings = m["warnings"].to_string();
+    assert!(warnings.contains("fastener hole"), "{warnings}");
+
+    let strict = tmp.path().join("strict");
+    let run = common::build::unfold([
+        model("torus-6x4").to_str().unwrap(),
+        "--scheme",
+        "woven",
+        "--size",
+        "180mm",
+        "--strict",
+        "--out",
+        strict.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    assert!(run.stderr.contains("refused by --strict"), "{}", run.stderr);
+    assert!(!strict.exists(), "--strict wrote {}", strict.display());
+}
+
 #[test]
 fn ribbons_do_not_pass_through_each_other() {
     let tmp = TempDir::new().unwrap();

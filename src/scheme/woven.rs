@@ -27,7 +27,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
-use super::{PanelLimit, Scheme, SchemeError, SchemeOutput};
+use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
@@ -919,15 +919,32 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
     let mut panels = Panels::new();
     let mut cycles = Vec::new();
     let mut joint = 0u32;
-    let mut holes_short = 0;
+    let mut joints_short = 0;
+    let mut unfastened = Vec::new();
     for (ribbon, plan) in ribbons.iter().zip(&plans) {
         let m = plan.len();
         for (s, &(start, len)) in plan.iter().enumerate() {
             // Joint s is at the start of segment s, joint s + 1 at its end.
             let joints = [joint + s as u32, joint + ((s + 1) % m) as u32];
             let partners = [(s + m - 1) % m, (s + 1) % m];
-            let (panel, short) = segment_panel(ribbon, s, start, len, joints, partners, options);
-            holes_short += short;
+            let (panel, at_start) = segment_panel(ribbon, s, start, len, joints, partners, options);
+            // Both segments of a joint carry the same holes: count each joint at the
+            // start of the segment after it.
+            let wanted = options.panel.holes as usize;
+            if wanted > 0 && at_start == 0 {
+                let PieceKind::Face { corner } = ribbon.pieces[ribbon.corner_start[start]] else {
+                    unreachable!("a face corner's pieces start in the face");
+                };
+                unfastened.push(ConnectionName {
+                    panels: [
+                        segment_id(ribbon.cycle, partners[0]),
+                        segment_id(ribbon.cycle, s),
+                    ],
+                    at: Name::Vertex(mesh.dest(corner).0),
+                });
+            } else if at_start < wanted {
+                joints_short += 1;
+            }
             panels.push(panel.view());
         }
         joint += m as u32;
@@ -939,9 +956,10 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
         });
     }
     let mut notes = Vec::new();
-    if holes_short > 0 {
+    if joints_short > 0 {
         notes.push(format!(
-            "{holes_short} joint ends have fewer holes than asked: the strand is too narrow there for the hole diameter"
+            "{joints_short} of {joint} lap joints have fewer than {} fastener holes (but at least one): the strand is too narrow there for more; a smaller --hole-diameter or --hole-margin, or a larger --size, helps",
+            options.panel.holes
         ));
     }
     if ribbon_notes.tight_corners > 0 {
@@ -957,13 +975,14 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
         notes,
         report: cycle_report(&cycles),
         manifest: cycle_manifest(&cycles),
+        unfastened,
         ..SchemeOutput::default()
     })
 }
 
 /// The panel of one segment: corners `start ..= start + len` of the ring (their face
-/// pieces) and the edge pieces between them. Returns it with the number of its joint
-/// ends that have fewer holes than asked.
+/// pieces) and the edge pieces between them. Returns it with the number of holes of
+/// the joint at its start.
 fn segment_panel(
     ribbon: &Ribbon,
     segment: usize,
@@ -1001,7 +1020,7 @@ fn segment_panel(
     let id = segment_id(ribbon.cycle, segment);
     let mut holes = Vec::new();
     let mut labels = Vec::new();
-    let mut short = 0;
+    let mut at_start = 0;
 
     // Lap joints at both ends: holes through the shared corner, and the id of the
     // segment joined there.
@@ -1012,8 +1031,10 @@ fn segment_panel(
     ];
     for (end, js) in ends.iter().enumerate() {
         let ks: Vec<usize> = js.iter().map(|&j| chain[j]).collect();
-        let (points, fewer) = joint_holes(ribbon, &ks, options);
-        short += usize::from(fewer);
+        let points = joint_holes(ribbon, &ks, options);
+        if end == 0 {
+            at_start = points.len();
+        }
         let facet_index = |piece: usize, local: usize| facet_start[js[piece]] + local;
         for (p, piece, local) in points {
             holes.push(Hole {
@@ -1076,7 +1097,7 @@ fn segment_panel(
             holes,
             labels,
         ),
-        short,
+        at_start,
     )
 }
 
@@ -1129,16 +1150,16 @@ fn strand_label(
 
 /// Fastener holes of a lap joint on the face pieces `ks` of one corner: 3D points
 /// with the piece (position in `ks`) and facet within it they go through, on the
-/// strand's centre line (one at the middle, two at a third and two thirds). The
-/// second value is true when fewer than asked fit.
+/// strand's centre line (one at the middle, two at a third and two thirds), those
+/// that fit.
 fn joint_holes(
     ribbon: &Ribbon,
     ks: &[usize],
     options: &WovenOptions,
-) -> (Vec<(DVec3, usize, usize)>, bool) {
+) -> Vec<(DVec3, usize, usize)> {
     let wanted = options.panel.holes as usize;
     if wanted == 0 || ks.is_empty() {
-        return (Vec::new(), false);
+        return Vec::new();
     }
     let mut local = Unrolled::new(ribbon, ks[0]);
     let mut owner = Vec::new();
@@ -1176,8 +1197,7 @@ fn joint_holes(
         let (piece, facet) = owner[i];
         points.push((local.frames[i].to_3d(q), piece, facet));
     }
-    let fewer = points.len() < fractions.len();
-    (points, fewer)
+    points
 }
 
 #[cfg(test)]
