@@ -293,8 +293,8 @@ fn smallest_angle([a, b, c]: [DVec3; 3]) -> f64 {
 /// One sweep of edge flips, in face order: the edge between triangles (a, b, c) and
 /// (b, a, d) becomes (c, d) where that gains [`FLIP_GAIN`] in the smallest angle of
 /// the two, the two bend less than [`FLIP_FLATNESS`] allows, both new triangles face
-/// the way the old ones did, c and d are not joined already, and the samples of the
-/// two keep within the bounds. Returns how many flipped.
+/// the way the old ones did before relaxing, c and d are not joined already, and the
+/// samples of the two keep within the bounds. Returns how many flipped.
 fn flip_edges(
     positions: &[DVec3],
     triangles: &mut [[u32; 3]],
@@ -341,13 +341,12 @@ fn flip_edges(
             let gain = smallest_angle(new1).min(smallest_angle(new2))
                 - smallest_angle(old1).min(smallest_angle(old2));
             let (n1, n2) = (area(old1), area(old2));
-            let normal = n1 + n2;
             let flat = n1.normalize_or_zero().dot(n2.normalize_or_zero()) >= FLIP_FLATNESS;
-            if gain < FLIP_GAIN
-                || !flat
-                || area(new1).dot(normal) <= 0.0
-                || area(new2).dot(normal) <= 0.0
-            {
+            // The new faces face the way the old ones did before relaxing, and keep that
+            // direction as the one no later move may turn them from.
+            let before = (initial_area[f] + initial_area[g]).normalize_or_zero();
+            let (a1, a2) = (area(new1), area(new2));
+            if gain < FLIP_GAIN || !flat || a1.dot(before) <= 0.0 || a2.dot(before) <= 0.0 {
                 continue;
             }
             let Some((changed, delta)) = deviation
@@ -359,8 +358,8 @@ fn flip_edges(
             deviation.keep(changed, delta);
             triangles[f] = [a, d, c];
             triangles[g] = [d, b, c];
-            initial_area[f] = area(new1);
-            initial_area[g] = area(new2);
+            initial_area[f] = a1.length() * before;
+            initial_area[g] = a2.length() * before;
             faces_of.remove(&key(a, b));
             faces_of.insert(key(c, d), vec![f, g]);
             for (edge, from, to) in [(key(a, d), g, f), (key(b, c), f, g)] {

@@ -354,8 +354,8 @@ impl Input<'_> {
         let mut relaxed_flips = 0;
         let mut measured = deviation(samples, &simplified);
         if let Some(surface) = &self.relax_onto {
-            // Relaxing moves vertices only: the connectivity, and so the topology just
-            // checked, stay.
+            // Relaxing moves vertices and flips edges between two faces into a diagonal
+            // not yet joined: the mesh stays a manifold of the topology just checked.
             let mut triangles: Vec<[u32; 3]> = polys.faces().map(|f| [f[0], f[1], f[2]]).collect();
             let mut positions = polys.positions.clone();
             let relaxed = relax(&mut positions, &mut triangles, surface);

@@ -368,6 +368,9 @@ fn polygon_gap(a: &[DVec2], b: &[DVec2]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// The least material (mm) a notch leaves between itself and a flap's fold.
+const MIN_KEEP: f64 = 1e-3;
+
 /// Sides of the polygon a notch runs round a pin with: the notch clears the pin by
 /// its full distance everywhere, its corners a little more.
 const NOTCH_SIDES: usize = 16;
@@ -376,10 +379,13 @@ const NOTCH_SIDES: usize = 16;
 /// notch round each of `pins`, the pins of other corners of its face that it would
 /// otherwise cover or come within `clear` of. Each notch is the band of width
 /// 2·`clear` from its pin straight away from the fold, round at the fold's end, so the
-/// flap keeps one outline without holes. `None` where a notch would come nearer the
-/// fold than `keep` (the flap must stay whole along it) or the flap would not stay
-/// one piece.
+/// flap keeps one outline without holes; a tip that a notch cuts off no longer hangs on
+/// the fold and is left out. `None` where a notch would come nearer the fold than
+/// `keep` (the flap must stay whole along it), or the flap would hang on a neck
+/// narrower than that.
 pub fn notch_flap(flap: &[DVec2], pins: &[DVec2], clear: f64, keep: f64) -> Option<Vec<DVec2>> {
+    // Even with no margin asked for, a notch must not touch the fold.
+    let keep = keep.max(MIN_KEEP);
     use i_overlay::core::fill_rule::FillRule;
     use i_overlay::core::overlay_rule::OverlayRule;
     use i_overlay::core::solver::Solver;

@@ -7,7 +7,8 @@
 //! the smaller one, turned about that edge into the larger one's plane, overlaps none of
 //! its faces, the union still fits the sheet and stays compact (its convex hull at most
 //! `--island-spread` times its area: sprawling islands waste the sheet between their
-//! arms). A second pass lets islands of a few faces join a neighbour whatever shape
+//! arms; a join that makes a whole connected part one island is made whatever its
+//! shape). A second pass lets islands of a few faces join a neighbour whatever shape
 //! that makes. Faces of an island that meet at a
 //! folded corner may touch there; any other two keep [`ISLAND_GAP`] apart, so the
 //! outline stays a simple polygon with room for the laser. Each island is a tree of
@@ -32,6 +33,11 @@ use crate::panel::{FoldKind, Hole, Label, LabelKind, Loops, Name, Panel, Panels,
 use crate::plane::{convex_hull, fits_rotated};
 use crate::record::{round4, Params};
 use crate::units::fmt_path_length;
+
+/// The default `--island-spread`: islands whose convex hull is at most one and a half
+/// times their area pack on fewer sheets than sprawling ones, at the cost of more
+/// (smaller) islands.
+pub const ISLAND_SPREAD: f64 = 1.5;
 
 /// Least distance (mm) between two faces or tabs of one island that are not joined:
 /// the laser needs room between two cuts, and an outline that touches itself is not
@@ -70,7 +76,7 @@ struct NetArgs {
 
     /// Largest ratio of an island's convex hull to its area (net scheme, at least 1):
     /// smaller keeps islands compact so they pack on fewer sheets, larger makes fewer
-    /// islands. [default: 2]
+    /// islands. [default: 1.5]
     #[arg(long, value_name = "R")]
     island_spread: Option<f64>,
 }
@@ -133,7 +139,7 @@ impl Scheme for Net {
                 "--flat-fold: {flat_fold} must be an angle in degrees from 0 to below 90"
             ));
         }
-        let island_spread = args.island_spread.unwrap_or(2.0);
+        let island_spread = args.island_spread.unwrap_or(ISLAND_SPREAD);
         if !(island_spread >= 1.0 && island_spread.is_finite()) {
             return Err(format!(
                 "--island-spread: {island_spread} must be a number of at least 1 (a convex island has 1)"
@@ -370,6 +376,7 @@ impl Islands {
             scale,
             spread,
             small,
+            component_faces,
         } = *rules;
         let h = e.half_edge();
         let (Some(f), Some(g)) = (mesh.face(h), mesh.face(h.twin())) else {
@@ -381,7 +388,12 @@ impl Islands {
         }
         let (size_a, size_b) = (self.faces[ia as usize].len(), self.faces[ib as usize].len());
         let total = size_a + size_b;
-        if options.max_island_faces.is_some_and(|m| total > m) || size_a.min(size_b) > small {
+        // A join that makes the whole object (or a whole part of it) one net is made
+        // whatever the shape, as a modeller would.
+        let completes = total == component_faces[f.index()];
+        if options.max_island_faces.is_some_and(|m| total > m)
+            || (size_a.min(size_b) > small && !completes)
+        {
             return false;
         }
         // The larger island (a) stays put; ties keep the lower index.
@@ -401,7 +413,7 @@ impl Islands {
         hull.extend(self.hull[b as usize].iter().map(|&x| turn.apply(x)));
         let hull = convex_hull(&hull);
         let area = self.area[a as usize] + self.area[b as usize];
-        if crate::plane::area(&hull) > spread * area && total > 2 {
+        if crate::plane::area(&hull) > spread * area && total > 2 && !completes {
             return false;
         }
         // Room for a tab's depth: tabs that would still stick out are cut back.
@@ -639,6 +651,8 @@ struct JoinRules<'a> {
     spread: f64,
     /// Join only when the smaller island has at most this many faces.
     small: usize,
+    /// The number of faces of each face's connected part of the mesh.
+    component_faces: &'a [usize],
 }
 
 /// The options for a half-edge tab of height `height`.
@@ -923,11 +937,20 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         .filter_map(|e| fold_angle(mesh, e).map(|a| (a, e)))
         .collect();
     order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1 .0.cmp(&y.1 .0)));
+    let component_faces: Vec<usize> = {
+        let (component, count) = mesh.face_components();
+        let mut sizes = vec![0usize; count];
+        for &c in &component {
+            sizes[c as usize] += 1;
+        }
+        component.iter().map(|&c| sizes[c as usize]).collect()
+    };
     let mut rules = JoinRules {
         options,
         scale: lengths.last().copied().unwrap_or(1.0),
         spread: options.island_spread,
         small: usize::MAX,
+        component_faces: &component_faces,
     };
     for &(_, e) in &order {
         islands.try_join(mesh, e, &rules);
