@@ -55,6 +55,7 @@ impl BandArgs {
             bridge_scale: fraction("bridge-scale", self.bridge_scale, 0.5)?,
             flap_scale: fraction("flap-scale", self.flap_scale, 0.5)?,
             samples,
+            deep_flaps: true,
         })
     }
 }
@@ -70,6 +71,9 @@ pub struct EdgeOptions {
     pub flap_scale: f64,
     /// Strips of the Bézier bend.
     pub samples: u32,
+    /// Whether flaps may grow past the face's other corners (notched round their
+    /// pins); not for a model too detailed for its fasteners (see [`edge_scheme`]).
+    pub deep_flaps: bool,
 }
 
 impl EdgeOptions {
@@ -492,10 +496,38 @@ pub fn edge_scheme(
     widen: WidenFor,
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> super::SchemeOutput {
+    // Flaps no deeper than the face's other corners first; then, for the faces whose
+    // corners are short of holes, flaps that may grow past them, unless the model stays
+    // too detailed for its fasteners even so (more than MOST_UNFASTENED of the corners
+    // bare; the build warns with a budget): it cannot be assembled as asked anyway, and
+    // deep flaps would cost sheets for a few more holes.
+    let shallow = EdgeOptions {
+        deep_flaps: false,
+        ..options.clone()
+    };
     let mut faces: Vec<FaceFlaps> = (0..mesh.face_count() as u32)
         .into_par_iter()
-        .map(|f| face_flaps(mesh, FaceId(f), options))
+        .map(|f| face_flaps(mesh, FaceId(f), &shallow))
         .collect();
+    if options.deep_flaps {
+        let deeper: Vec<(usize, FaceFlaps)> = (0..faces.len())
+            .into_par_iter()
+            .filter(|&k| !faces[k].bare.is_empty() || faces[k].reduced > 0)
+            .map(|k| (k, face_flaps(mesh, FaceId(k as u32), options)))
+            .collect();
+        let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
+        let bare: usize = faces.iter().map(|f| f.bare.len()).sum();
+        let fastened: usize = deeper
+            .iter()
+            .map(|(k, d)| faces[*k].bare.len() as isize - d.bare.len() as isize)
+            .sum::<isize>()
+            .max(0) as usize;
+        if (bare.saturating_sub(fastened) as f64) <= super::MOST_UNFASTENED * corners as f64 {
+            for (k, flaps) in deeper {
+                faces[k] = flaps;
+            }
+        }
+    }
     widen_bands(mesh, options, widen, &face_flaps, &mut faces);
     let panels = edge_panels(mesh, &faces, options);
     let connections: usize = faces.iter().map(FaceFlaps::corners).sum();

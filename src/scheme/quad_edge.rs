@@ -86,14 +86,18 @@ pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
 }
 
 /// The deepest a flap grows, in units of its band edge's distance from the face centre
-/// (1 reaches the centre, 3 a triangle's far corner): beyond one and a half, a
+/// (1 reaches the centre, 3 a triangle's far corner): beyond [`SHALLOW_FLAP_SCALE`], a
 /// triangle's flaps cover the third flap's corners, and are notched round the pins
 /// there.
 pub const MAX_FLAP_SCALE: f64 = 2.5;
 
-/// Steps from `--flap-scale` to [`MAX_FLAP_SCALE`] tried when a corner's overlap is too
-/// small for its holes.
-const FLAP_STEPS: u32 = 32;
+/// The deepest a flap grows without reaching a triangle's other corners, where a model
+/// is too detailed for its fasteners (`EdgeOptions::deep_flaps` off).
+pub const SHALLOW_FLAP_SCALE: f64 = 1.5;
+
+/// The step in depth (same units) between the depths tried when a corner's overlap is
+/// too small for its holes.
+const FLAP_STEP: f64 = 1.0 / 16.0;
 
 /// A face corner's plan: how deep its two flaps go, its label point and its pins.
 #[derive(Clone)]
@@ -185,11 +189,15 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
             });
         (centre, best.1)
     };
-    let depths: Vec<f64> = (0..FLAP_STEPS + 1)
-        .map(|i| {
-            let t = f64::from(i) / f64::from(FLAP_STEPS);
-            options.flap_scale + t * (MAX_FLAP_SCALE - options.flap_scale).max(0.0)
-        })
+    let deepest = if options.deep_flaps {
+        MAX_FLAP_SCALE
+    } else {
+        SHALLOW_FLAP_SCALE
+    };
+    let range = (deepest - options.flap_scale).max(0.0);
+    let steps = (range / FLAP_STEP).ceil().max(1.0) as u32;
+    let depths: Vec<f64> = (0..steps + 1)
+        .map(|i| options.flap_scale + range * f64::from(i) / f64::from(steps))
         .collect();
     // Per corner: the shallowest depth at which its two flaps hold `wanted` pins, with
     // the pins (placed for that depth, they stay valid when the flaps grow deeper:
