@@ -11,8 +11,8 @@ use glam::{DVec2, DVec3};
 use crate::labels::{fit_labels, LabelOptions, LeftOut};
 use crate::mesh::geometry::vector_area;
 use crate::panel::{
-    fill_arena, Arena, FacetFrame, FlatHole, FlatPanel, FlatPanels, Fold, FoldKind, PanelRef,
-    Panels,
+    fill_arena, FacetFrame, FlatHole, FlatPanel, FlatPanels, Fold, FoldKind, PanelRef, Panels,
+    Tallied,
 };
 use crate::plane::loop_signed_area;
 
@@ -243,32 +243,14 @@ pub fn unroll_all(
     options: LabelOptions,
     flat_fold: f64,
 ) -> Result<(FlatPanels, LeftOut), FlattenError> {
-    let Unrolled { mut flat, left_out } = fill_arena(panels.len(), |i| {
+    let Tallied {
+        panels: mut flat,
+        tally: left_out,
+    } = fill_arena(panels.len(), |i| {
         unroll_fit(panels.get(i), options, flat_fold)
     })?;
     flat.shrink_to_fit();
     Ok((flat, left_out))
-}
-
-/// Flat panels and the labels left out on them, as [`unroll_all`] collects them.
-#[derive(Default)]
-struct Unrolled {
-    flat: FlatPanels,
-    left_out: LeftOut,
-}
-
-impl Arena for Unrolled {
-    type Made = (FlatPanel, LeftOut);
-
-    fn take(&mut self, (panel, left_out): (FlatPanel, LeftOut)) {
-        self.flat.take(panel);
-        self.left_out = self.left_out + left_out;
-    }
-
-    fn append(&mut self, other: Unrolled) {
-        self.flat.append(other.flat);
-        self.left_out = self.left_out + other.left_out;
-    }
 }
 
 /// Chains the edges used by one facet into loops, outer (largest area, counter-

@@ -24,7 +24,7 @@ use i_overlay::float::single::SingleFloatOverlay;
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 
-use crate::panel::{fill_arena, Arena, FlatPanel, FlatPanelRef, FlatPanels, Loops};
+use crate::panel::{fill_arena, FlatPanel, FlatPanelRef, FlatPanels, Loops, Tallied};
 use crate::plane::{perimeter, signed_area};
 
 /// Corners sharper than this (radians, inside angle) are bevelled instead of mitred:
@@ -66,37 +66,18 @@ pub struct Compensated {
 /// hole's diameter by `kerf`, in parallel, the panels in their order. `kerf` must be
 /// below every hole's diameter (the options check it).
 pub fn compensate_all(panels: &FlatPanels, kerf: f64) -> Compensated {
-    let tally: Result<Tally, std::convert::Infallible> =
-        fill_arena(panels.len(), |i| Ok(compensate(panels.get(i), kerf)));
-    let Ok(Tally {
+    let tallied: Result<Tallied<usize>, std::convert::Infallible> = fill_arena(panels.len(), |i| {
+        let (panel, narrow) = compensate(panels.get(i), kerf);
+        Ok((panel, usize::from(narrow)))
+    });
+    let Ok(Tallied {
         mut panels,
-        narrow_panels,
-    }) = tally;
+        tally: narrow_panels,
+    }) = tallied;
     panels.shrink_to_fit();
     Compensated {
         panels,
         narrow_panels,
-    }
-}
-
-/// Flat panels and how many have narrow places, as [`compensate_all`] gathers them.
-#[derive(Default)]
-struct Tally {
-    panels: FlatPanels,
-    narrow_panels: usize,
-}
-
-impl Arena for Tally {
-    type Made = (FlatPanel, bool);
-
-    fn take(&mut self, (panel, narrow): (FlatPanel, bool)) {
-        self.panels.take(panel);
-        self.narrow_panels += usize::from(narrow);
-    }
-
-    fn append(&mut self, other: Tally) {
-        self.panels.append(other.panels);
-        self.narrow_panels += other.narrow_panels;
     }
 }
 

@@ -1016,6 +1016,30 @@ impl Views for FlatPanels {
     }
 }
 
+/// Flat panels gathered with a tally of something about each (labels left out,
+/// narrow places), summed as [`fill_arena`] gathers them.
+#[derive(Default)]
+pub struct Tallied<T> {
+    /// The panels, in order.
+    pub panels: FlatPanels,
+    /// The sum of their tallies.
+    pub tally: T,
+}
+
+impl<T: Default + Send + std::ops::Add<Output = T>> Arena for Tallied<T> {
+    type Made = (FlatPanel, T);
+
+    fn take(&mut self, (panel, tally): (FlatPanel, T)) {
+        self.panels.take(panel);
+        self.tally = std::mem::take(&mut self.tally) + tally;
+    }
+
+    fn append(&mut self, other: Tallied<T>) {
+        self.panels.append(other.panels);
+        self.tally = std::mem::take(&mut self.tally) + other.tally;
+    }
+}
+
 impl Arena for FlatPanels {
     type Made = FlatPanel;
 

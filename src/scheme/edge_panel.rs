@@ -6,6 +6,12 @@
 //! outline and the holes on each flap. [`edge_panels`] turns those into panels.
 
 use glam::{DVec2, DVec3};
+use i_overlay::core::fill_rule::FillRule;
+use i_overlay::core::overlay_rule::OverlayRule;
+use i_overlay::core::solver::Solver;
+use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
+use i_overlay::mesh::float::outline::offset::OutlineOffset;
+use i_overlay::mesh::float::style::OutlineStyle;
 use rayon::prelude::*;
 
 use super::{face_band, PanelDefaults, PanelOptions};
@@ -390,12 +396,6 @@ const NOTCH_SIDES: usize = 16;
 pub fn notch_flap(flap: &[DVec2], pins: &[DVec2], clear: f64, keep: f64) -> Option<Vec<DVec2>> {
     // Even with no margin asked for, a notch must not touch the fold.
     let keep = keep.max(MIN_KEEP);
-    use i_overlay::core::fill_rule::FillRule;
-    use i_overlay::core::overlay_rule::OverlayRule;
-    use i_overlay::core::solver::Solver;
-    use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
-    use i_overlay::mesh::float::outline::offset::OutlineOffset;
-    use i_overlay::mesh::float::style::OutlineStyle;
 
     let (fold_start, fold_end) = (flap[0], flap[1]);
     let inward = (fold_end - fold_start).perp().normalize_or_zero();
@@ -497,10 +497,7 @@ pub fn edge_scheme(
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> super::SchemeOutput {
     // Flaps no deeper than the face's other corners first; then, for the faces whose
-    // corners are short of holes, flaps that may grow past them, unless the model stays
-    // too detailed for its fasteners even so (more than MOST_UNFASTENED of the corners
-    // bare; the build warns with a budget): it cannot be assembled as asked anyway, and
-    // deep flaps would cost sheets for a few more holes.
+    // corners are short of holes, flaps that may grow past them (`keep_if_fastened`).
     let shallow = EdgeOptions {
         deep_flaps: false,
         ..options.clone()
@@ -515,18 +512,7 @@ pub fn edge_scheme(
             .filter(|&k| !faces[k].bare.is_empty() || faces[k].reduced > 0)
             .map(|k| (k, face_flaps(mesh, FaceId(k as u32), options)))
             .collect();
-        let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
-        let bare: usize = faces.iter().map(|f| f.bare.len()).sum();
-        let fastened: usize = deeper
-            .iter()
-            .map(|(k, d)| faces[*k].bare.len() as isize - d.bare.len() as isize)
-            .sum::<isize>()
-            .max(0) as usize;
-        if (bare.saturating_sub(fastened) as f64) <= super::MOST_UNFASTENED * corners as f64 {
-            for (k, flaps) in deeper {
-                faces[k] = flaps;
-            }
-        }
+        keep_if_fastened(&mut faces, deeper);
     }
     widen_bands(mesh, options, widen, &face_flaps, &mut faces);
     let panels = edge_panels(mesh, &faces, options);
@@ -540,11 +526,8 @@ pub fn edge_scheme(
     }
 }
 
-/// Widens the bands of the faces whose corners need room ([`widened_band`]), unless
-/// the model stays too detailed for its fasteners even then (more than
-/// [`super::MOST_UNFASTENED`] of the corners bare; the build warns with a budget): it
-/// keeps its own bands, since wider ones would cost sheets for a panel set that cannot
-/// be assembled as asked anyway.
+/// Widens the bands of the faces whose corners need room ([`widened_band`]), where
+/// [`keep_if_fastened`] lets it.
 fn widen_bands(
     mesh: &Mesh,
     options: &EdgeOptions,
@@ -565,14 +548,24 @@ fn widen_bands(
             )
         })
         .collect();
+    keep_if_fastened(faces, widened);
+}
+
+/// Puts the flaps `tried` (a face's index, its flaps) in place of those faces', unless
+/// the model stays too detailed for its fasteners even with them: more than
+/// [`super::MOST_UNFASTENED`] of the corners bare (the build then warns with a budget,
+/// and the larger flaps would cost sheets for a panel set that cannot be assembled as
+/// asked anyway).
+fn keep_if_fastened(faces: &mut [FaceFlaps], tried: Vec<(usize, FaceFlaps)>) {
     let corners: usize = faces.iter().map(FaceFlaps::corners).sum();
     let bare_before: usize = faces.iter().map(|f| f.bare.len()).sum();
-    let fastened: usize = widened
+    let fastened = tried
         .iter()
-        .map(|(k, w)| faces[*k].bare.len() - w.bare.len())
-        .sum();
-    if ((bare_before - fastened) as f64) <= super::MOST_UNFASTENED * corners as f64 {
-        for (k, flaps) in widened {
+        .map(|(k, t)| faces[*k].bare.len() as isize - t.bare.len() as isize)
+        .sum::<isize>()
+        .max(0) as usize;
+    if (bare_before.saturating_sub(fastened) as f64) <= super::MOST_UNFASTENED * corners as f64 {
+        for (k, flaps) in tried {
             faces[k] = flaps;
         }
     }
