@@ -89,7 +89,7 @@ pub fn main(registry: &Registry, args: impl IntoIterator<Item = OsString>) -> Ex
         Ok(cli) => cli,
         Err(e) => return usage_error(e),
     };
-    match run(cli, registry) {
+    match crate::internal::catch(|| run(cli, registry)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // The whole chain of causes, each once: a message that already quotes

@@ -99,6 +99,16 @@ pub enum Error {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// A panic: a bug of unfold, caught and reported on one line (exit code 1).
+    #[error("internal error while {stage}{}: {message}; this is a bug in unfold: please report it with the model file and the command line", panel.as_ref().map(|id| format!(" (panel {id})")).unwrap_or_default())]
+    Panic {
+        /// The stage that was running ("nesting 41 panels on sheets").
+        stage: String,
+        /// The id of the panel it was working on, where one was.
+        panel: Option<String>,
+        /// What the panic said, and where.
+        message: String,
+    },
 }
 
 impl Error {
@@ -116,7 +126,7 @@ impl Error {
     /// The process exit code for this error: 1 runtime, 2 usage, 3 bad input model.
     pub fn exit_code(&self) -> i32 {
         match self {
-            Error::Build(_) | Error::Io { .. } | Error::Internal { .. } => 1,
+            Error::Build(_) | Error::Io { .. } | Error::Internal { .. } | Error::Panic { .. } => 1,
             Error::Usage(_) => 2,
             Error::Input(_) => 3,
         }

@@ -247,7 +247,7 @@ pub fn unroll_all(
         panels: mut flat,
         tally: left_out,
     } = fill_arena(panels.len(), |i| {
-        unroll_fit(panels.get(i), options, flat_fold)
+        crate::internal::for_panel(i, || unroll_fit(panels.get(i), options, flat_fold))
     })?;
     flat.shrink_to_fit();
     Ok((flat, left_out))

@@ -67,7 +67,7 @@ pub struct Compensated {
 /// below every hole's diameter (the options check it).
 pub fn compensate_all(panels: &FlatPanels, kerf: f64) -> Compensated {
     let tallied: Result<Tallied<usize>, std::convert::Infallible> = fill_arena(panels.len(), |i| {
-        let (panel, narrow) = compensate(panels.get(i), kerf);
+        let (panel, narrow) = crate::internal::for_panel(i, || compensate(panels.get(i), kerf));
         Ok((panel, usize::from(narrow)))
     });
     let Ok(Tallied {

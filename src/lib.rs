@@ -16,6 +16,7 @@ pub mod export;
 pub mod flatten;
 pub mod font;
 pub mod inspect;
+pub mod internal;
 pub mod kerf;
 pub mod labels;
 pub mod load;

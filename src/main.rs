@@ -3,5 +3,6 @@
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    unfold::internal::install_hook();
     unfold::cli::main(&unfold::scheme::Registry::default(), std::env::args_os())
 }

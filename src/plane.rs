@@ -165,6 +165,42 @@ pub fn is_simple(poly: &[DVec2]) -> bool {
     true
 }
 
+/// True when a closed polygon is simple with room to spare: every two edges that do not
+/// share a corner stay more than `gap` apart, and at every corner each edge's far end
+/// stays more than `gap` from the other edge (no spike folding back on its edge, no
+/// corner on a neighbouring edge). A polygon that passes stays simple when its
+/// coordinates are rounded by less than half of `gap`. Edges are swept in order of
+/// their left end, so long outlines cost little more than their length.
+pub fn is_clear(poly: &[DVec2], gap: f64) -> bool {
+    let n = poly.len();
+    if n < 3 || poly.iter().any(|p| !p.is_finite()) {
+        return false;
+    }
+    for i in 0..n {
+        let (a, v, b) = (poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]);
+        if distance_to_segment(b, a, v) <= gap || distance_to_segment(a, v, b) <= gap {
+            return false;
+        }
+    }
+    let mut order: Vec<usize> = (0..n).collect();
+    let left = |i: usize| poly[i].x.min(poly[(i + 1) % n].x);
+    order.sort_by(|&i, &j| left(i).total_cmp(&left(j)).then(i.cmp(&j)));
+    for (k, &i) in order.iter().enumerate() {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        let right = a.x.max(b.x) + gap;
+        for &j in &order[k + 1..] {
+            if left(j) > right {
+                break;
+            }
+            let neighbours = j == (i + 1) % n || i == (j + 1) % n;
+            if !neighbours && segment_distance(a, b, poly[j], poly[(j + 1) % n]) <= gap {
+                return false;
+            }
+        }
+    }
+    true
+}
+
 /// True when the two polygons' interiors or borders meet.
 pub fn polygons_touch(p: &[DVec2], q: &[DVec2]) -> bool {
     for i in 0..p.len() {
@@ -383,9 +419,170 @@ pub fn offset_outline(poly: &[DVec2], r: f64) -> Vec<DVec2> {
     out
 }
 
+/// Segments of the exact offset's round corners, as a share of the radius: their
+/// chords fall at most r/800 inside the true arc, which the nester's safety covers.
+const ROUND_OFFSET_STEP: f64 = 0.1;
+
+/// The outline of a simple polygon grown by `r` (r ≥ 0), as a polygon that is
+/// [`is_clear`] by `gap`: the quick [`offset_outline`] where that is clear; otherwise,
+/// where it would fold back or overlap itself (a concavity narrower than 2r, a reflex
+/// corner between edges shorter than r), the outer contour of the exact offset region
+/// (round corners, on i_overlay's integer grid); and where even that is not clear, the
+/// grown convex hull, which only covers more.
+pub fn grown_outline(poly: &[DVec2], r: f64, gap: f64) -> Vec<DVec2> {
+    let quick = merge_close_corners(offset_outline(poly, r), gap);
+    if is_clear(&quick, gap) {
+        return quick;
+    }
+    if let Some(exact) = exact_offset(poly, r)
+        .map(|c| merge_close_corners(c, gap))
+        .filter(|c| is_clear(c, gap))
+    {
+        return exact;
+    }
+    merge_close_corners(offset_outline(&convex_hull(poly), r), gap)
+}
+
+/// A closed polygon without the corners that lie within `gap` of the corner kept
+/// before them (the first corner is kept).
+fn merge_close_corners(poly: Vec<DVec2>, gap: f64) -> Vec<DVec2> {
+    let mut kept: Vec<DVec2> = Vec::with_capacity(poly.len());
+    for p in poly {
+        if kept.last().is_none_or(|q| q.distance(p) > gap) {
+            kept.push(p);
+        }
+    }
+    while kept.len() > 1 && kept[0].distance(kept[kept.len() - 1]) <= gap {
+        kept.pop();
+    }
+    kept
+}
+
+/// The outer contour of the region within `r` of a polygon (the polygon alone when
+/// `r` is 0), counter-clockwise, holes filled: the contour of the largest piece.
+fn exact_offset(poly: &[DVec2], r: f64) -> Option<Vec<DVec2>> {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::float::simplify::SimplifyShape;
+    use i_overlay::mesh::float::outline::offset::OutlineOffset;
+    use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
+    let contour: Vec<[f64; 2]> = counter_clockwise(poly).iter().map(|p| [p.x, p.y]).collect();
+    let region = contour.simplify_shape_as::<i64>(FillRule::NonZero);
+    let shapes = if r > 0.0 {
+        let mut style = OutlineStyle::new(r);
+        style.join = LineJoin::Round(ROUND_OFFSET_STEP);
+        region.outline_as::<i64>(&style)
+    } else {
+        region
+    };
+    shapes
+        .into_iter()
+        .filter_map(|shape| shape.into_iter().next())
+        .map(|outer| {
+            outer
+                .into_iter()
+                .map(|[x, y]| DVec2::new(x, y))
+                .collect::<Vec<_>>()
+        })
+        .max_by(|a, b| area(a).total_cmp(&area(b)))
+        .map(|outer| counter_clockwise(&outer))
+}
+
 #[cfg(test)]
 mod offset_tests {
     use super::*;
+
+    #[test]
+    fn a_spike_or_a_touch_is_not_clear() {
+        let square =
+            [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)].map(|(x, y)| DVec2::new(x, y));
+        assert!(is_clear(&square, 1e-3));
+        // A spike folding back along its own edge: simple by `is_simple`, not clear.
+        let spiked = [
+            (0.0, 0.0),
+            (10.0, 0.0),
+            (12.0, 2.0),
+            (11.0, 1.0001),
+            (10.0, 10.0),
+            (0.0, 10.0),
+        ]
+        .map(|(x, y)| DVec2::new(x, y));
+        assert!(is_simple(&spiked) && !is_clear(&spiked, 1e-3));
+        // A corner within the gap of an edge that does not share it.
+        let pinched = [
+            (0.0, 0.0),
+            (10.0, 0.0),
+            (10.0, 10.0),
+            (5.0, 0.0005),
+            (0.0, 10.0),
+        ]
+        .map(|(x, y)| DVec2::new(x, y));
+        assert!(!is_clear(&pinched, 1e-3) && is_clear(&pinched, 1e-4));
+    }
+
+    #[test]
+    fn a_tab_cut_back_beside_a_reflex_corner_grows_into_a_clear_outline() {
+        // A half-edge panel of the decimated knight (2 ft, kerf 0.2 mm): its cut-back
+        // tab leaves edges a few tenths of a millimetre long beside a reflex corner,
+        // which the quick offset by 1.6 mm folds back over.
+        let outline: Vec<DVec2> = [
+            (-18.61452, -8.88697),
+            (-18.73436, -9.04693),
+            (-18.07591, -9.04693),
+            (-17.57531, -9.54753),
+            (-17.56425, -9.55859),
+            (-17.55035, -9.56574),
+            (-3.03152, -17.03585),
+            (-3.00999, -17.04693),
+            (-2.98577, -17.04693),
+            (-1.74663, -17.04693),
+            (-1.72763, -17.04693),
+            (-1.70995, -17.03996),
+            (17.75562, -9.36540),
+            (17.77496, -9.35778),
+            (17.78966, -9.34308),
+            (18.08581, -9.04693),
+            (18.73436, -9.04693),
+            (18.62682, -8.89032),
+            (0.89459, 16.93204),
+            (0.81570, 17.04693),
+            (0.73213, 16.93539),
+            (0.45716, 16.56839),
+            (-0.24829, 16.46725),
+            (-0.26370, 16.46504),
+            (-0.27772, 16.45825),
+            (-14.92864, 9.35629),
+            (-14.95049, 9.34569),
+            (-14.96505, 9.32626),
+            (-17.00072, 6.60921),
+            (-17.01729, 6.58709),
+            (-17.02015, 6.55961),
+            (-18.48367, -7.49351),
+            (-18.48495, -7.50582),
+            (-18.48319, -7.51806),
+            (-18.33955, -8.51997),
+        ]
+        .iter()
+        .map(|&(x, y)| DVec2::new(x, y))
+        .collect();
+        assert!(is_clear(&outline, 1e-3));
+        let r = 1.6075;
+        assert!(!is_clear(&offset_outline(&outline, r), 1e-3));
+        let grown = grown_outline(&outline, r, 1e-3);
+        assert!(is_clear(&grown, 1e-3) && signed_area(&grown) > 0.0);
+        // It holds the whole r-neighbourhood (but for the round corners' chords) and
+        // no more than the convex hull's.
+        for &p in &outline {
+            assert!(contains(&grown, p));
+        }
+        for (i, &a) in outline.iter().enumerate() {
+            let b = outline[(i + 1) % outline.len()];
+            let out = DVec2::new(b.y - a.y, a.x - b.x).normalize();
+            let mid = 0.5 * (a + b) + (r - 1e-2) * out;
+            assert!(contains(&grown, mid), "edge {i}");
+        }
+        let hull = offset_outline(&convex_hull(&outline), r);
+        assert!(area(&grown) <= area(&hull));
+    }
 
     #[test]
     fn a_grown_square_contains_the_neighbourhood_and_stays_close_to_it() {

@@ -70,8 +70,10 @@ impl Progress {
         Progress(Some(bar))
     }
 
-    /// Names the stage now running, with a spinner.
+    /// Names the stage now running, with a spinner (and for an internal error's
+    /// message).
     fn stage(&self, what: &str) {
+        crate::internal::enter_stage(what);
         if let Some(bar) = &self.0 {
             if let Ok(style) =
                 indicatif::ProgressStyle::with_template("{spinner} {msg} ({elapsed})")
@@ -85,6 +87,7 @@ impl Progress {
 
     /// Names the stage now running, with a bar that [`Progress::set`] fills.
     fn bar(&self, what: &str) {
+        crate::internal::enter_stage(what);
         if let Some(bar) = &self.0 {
             // In this order, so no frame mixes the old stage's name or style with the
             // new one's.
@@ -624,6 +627,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     clock.lap("split");
     progress.stage("making the panels");
     let output = scheme(job, &prepared)?;
+    crate::internal::name_panels(output.panels.iter().map(|p| p.id().to_string()));
     let fastening = crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output);
     // Under --strict it is a refusal after the label check (which may refuse first).
     if let (Some(warning), false) = (&fastening, job.strict) {

@@ -87,6 +87,29 @@ struct Measured {
     worst_narrow_growth: f64,
 }
 
+/// What a loop's corners add to its material's growth beyond its perimeter × `h` when
+/// it is offset by `h` into the waste (`outer`: outward): a mitred corner turning by φ
+/// adds h² tan(φ/2), one sharper than 15° is bevelled and adds h² sin(φ)/2, a corner
+/// turning the other way takes h² tan(|φ|/2) off.
+fn corner_growth(lp: &[DVec2], outer: bool, h: f64) -> f64 {
+    let n = lp.len();
+    let part_side = signed_area(lp).signum() * if outer { 1.0 } else { -1.0 };
+    (0..n)
+        .map(|i| {
+            let (a, v, b) = (lp[(i + n - 1) % n], lp[i], lp[(i + 1) % n]);
+            let (u, w) = (v - a, b - v);
+            let turn = part_side * u.perp_dot(w).atan2(u.dot(w));
+            if turn < 0.0 {
+                -h * h * (-0.5 * turn).tan()
+            } else if std::f64::consts::PI - turn < std::f64::consts::PI / 12.0 {
+                0.5 * h * h * turn.sin()
+            } else {
+                h * h * (0.5 * turn).tan()
+            }
+        })
+        .sum()
+}
+
 /// The flat panels of a job without a kerf, from the pipeline's own stages.
 fn nominal_panels(job: &unfold::Job) -> Vec<FlatPanel> {
     assert_eq!(job.kerf, 0.0);
@@ -228,7 +251,12 @@ fn check_kerf(test: &str, scheme: &str, model: &Path, size: &str, holes: u32) ->
         let nominal_material = area(outer) - loops[1..].iter().map(|c| area(c)).sum::<f64>();
         let cut_material = area(cut_outer) - cut_inner.iter().map(|c| area(c)).sum::<f64>();
         let growth = cut_material - nominal_material;
-        let want = (perimeters - narrow) * half;
+        let corners: f64 = loops
+            .iter()
+            .enumerate()
+            .map(|(k, lp)| corner_growth(lp, k == 0, half))
+            .sum();
+        let want = (perimeters - narrow) * half + if narrow == 0.0 { corners } else { 0.0 };
         let error = (growth - want).abs() / want;
         if narrow == 0.0 {
             m.worst_growth = m.worst_growth.max(error);
@@ -371,4 +399,27 @@ fn islands_with_inner_cuts_keep_them() {
     assert!(m.inner_cuts > 0, "{m:?}");
     assert!(m.worst_growth < 0.01, "{m:?}");
     assert!(m.worst_narrow_growth < 0.05, "{m:?}");
+}
+
+#[test]
+fn half_edge_panels_with_shortened_tabs_take_a_kerf() {
+    let Some(dir) = shared_models("half_edge_panels_with_shortened_tabs_take_a_kerf") else {
+        return;
+    };
+    // Tabs cut back where they would meet their panel leave short edges beside reflex
+    // corners: grown for the spacing, such an outline folds back on itself unless the
+    // nester repairs it.
+    for (name, file) in [
+        ("knight", "decimated-knight.off"),
+        ("suzanne", "suzanne.obj"),
+    ] {
+        let m = check_kerf(name, "half-edge", &dir.join(file), "2ft", 0);
+        eprintln!("{name}: {m:?}");
+        assert!(m.panels > 400, "{name}: {m:?}");
+        // Small triangles whose cut-back tabs leave edges shorter than a mitre beside
+        // sharp corners: neighbouring mitres overlap, which the corner terms do not
+        // count (up to 2 % of a 5 mm² growth here).
+        assert!(m.worst_growth < 0.03, "{name}: {m:?}");
+        assert!(m.worst_narrow_growth < 0.05, "{name}: {m:?}");
+    }
 }

@@ -49,7 +49,7 @@ mod separate;
 
 use super::grid::Grid;
 use super::{Layout, NestProgress, Placement, SheetSpec, TooLarge};
-use crate::plane::{bounds, convex_hull, offset_outline};
+use crate::plane::{bounds, convex_hull, grown_outline, is_clear};
 use crate::rng::SplitMix64;
 
 /// Search settings of the true-shape nester.
@@ -76,6 +76,11 @@ const SAFETY: f64 = 0.02;
 /// corners of the round offset joins and the Bézier rails, which cost collision time,
 /// without costing a sheet.
 const SIMPLIFY: f32 = 0.001;
+
+/// Edges of a part's collision shape that do not share a corner keep at least this far
+/// apart (mm), and so do a corner's edges' far ends: f32 rounding of coordinates up to
+/// a few metres moves a corner by less than a tenth of it.
+const CLEARANCE: f64 = 1e-3;
 
 /// Weight of the x coordinate in the bottom-left score (y counts 1): with the contact
 /// bonus, half weight packs tighter than smaller ones.
@@ -324,14 +329,16 @@ fn prepare(
         .par_iter()
         .enumerate()
         .map(|(i, outline)| {
-            prepare_part(
-                i,
-                outline,
-                half_gap + SAFETY,
-                options,
-                &cde_config,
-                bounds_rect,
-            )
+            crate::internal::for_panel(i, || {
+                prepare_part(
+                    i,
+                    outline,
+                    half_gap + SAFETY,
+                    options,
+                    &cde_config,
+                    bounds_rect,
+                )
+            })
             .ok_or_else(|| too_large(i, outline, sheet, options.rotations))
         })
         .collect::<Vec<_>>()
@@ -351,24 +358,25 @@ fn prepare_part(
 ) -> Option<Part> {
     let (lo, hi) = bounds(outline.iter().copied());
     let center = 0.5 * (lo + hi);
-    // Our own offset keeps the shapes small (at most four points per corner); where
-    // it overlaps itself (a concavity narrower than the spacing), the engine's exact
-    // buffer is used, and where f32 rounding still breaks the outline, the convex
-    // hull, which only covers more.
-    let item = make_item(
-        index,
-        &offset_outline(outline, inflate),
-        center,
-        0.0,
-        options,
-        cde_config,
-    )
-    .or_else(|| make_item(index, outline, center, inflate, options, cde_config))
-    .or_else(|| {
-        let hull = offset_outline(&convex_hull(outline), inflate);
-        make_item(index, &hull, center, 0.0, options, cde_config)
-    })
-    .expect("the grown convex hull of a panel with area is a valid polygon");
+    // The grown outline is clear of itself by far more than f32 rounding moves a
+    // corner, so the engine's own checks and simplification see a simple polygon;
+    // where the engine still refuses it, the grown convex hull only covers more.
+    let grown: Vec<DVec2> = grown_outline(outline, inflate, CLEARANCE)
+        .into_iter()
+        .map(|p| p - center)
+        .collect();
+    let item = make_item(index, &grown, options, cde_config)
+        .or_else(|| {
+            let hull = grown_outline(&convex_hull(&grown), 0.0, CLEARANCE);
+            make_item(index, &hull, options, cde_config)
+        })
+        .or_else(|| {
+            // A box round it: four corners far apart, whatever the outline.
+            let (lo, hi) = bounds(grown.iter().copied());
+            let (lo, hi) = (lo - DVec2::splat(CLEARANCE), hi + DVec2::splat(CLEARANCE));
+            let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+            make_item(index, &corners, options, cde_config)
+        })?;
     let shape = item.shape_cd().as_ref().clone();
     let mut turned = shape.clone();
     let steps = options.rotations.max(1);
@@ -421,23 +429,24 @@ fn prepare_part(
     })
 }
 
-/// The jagua-rs item of an outline moved so that `center` is the origin and grown by
-/// the engine by `inflate`, or `None` when f32 rounding or the growing makes it
-/// invalid.
+/// The jagua-rs item of an outline already grown and centred, or `None` when it is not
+/// clear of itself in f32 (the engine's simplification would then panic).
 fn make_item(
     index: usize,
     outline: &[DVec2],
-    center: DVec2,
-    inflate: f64,
     options: &NestOptions,
     cde_config: &CDEConfig,
 ) -> Option<Arc<Item>> {
-    let mut points: Vec<Point> = Vec::with_capacity(outline.len());
-    for p in outline {
-        let q = Point((p.x - center.x) as f32, (p.y - center.y) as f32);
-        if !points.contains(&q) {
-            points.push(q);
-        }
+    let points: Vec<Point> = outline
+        .iter()
+        .map(|p| Point(p.x as f32, p.y as f32))
+        .collect();
+    let rounded: Vec<DVec2> = points
+        .iter()
+        .map(|p| DVec2::new(f64::from(p.0), f64::from(p.1)))
+        .collect();
+    if !is_clear(&rounded, 0.5 * CLEARANCE) {
+        return None;
     }
     let shape = SPolygon::new(points).ok()?;
     let original = OriginalShape {
@@ -445,7 +454,7 @@ fn make_item(
         pre_transform: DTransformation::empty(),
         modify_mode: ShapeModifyMode::Inflate,
         modify_config: ShapeModifyConfig {
-            offset: (inflate > 0.0).then_some(inflate as f32),
+            offset: None,
             simplify_tolerance: Some(SIMPLIFY),
             narrow_concavity_cutoff: None,
         },
