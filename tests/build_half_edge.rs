@@ -4,7 +4,8 @@
 //! library stages directly (scheme → flatten) to follow holes and labels back to 3D.
 //!
 //! Tests that use `../shared/models` skip with a message when that folder is absent.
-//! The DXF check (ezdxf through `tests/check_dxf.py`) costs about a second per sheet, a
+//! The DXF check (read back in Rust, and by ezdxf through `tests/check_dxf.py` where
+//! python3 has it) costs ezdxf about a second per sheet, a
 //! few seconds for the big sheets of spot and fertility: for those two models only the
 //! first and the last sheet's DXF are checked (every SVG still is), unless
 //! `UNFOLD_FULL_DXF=1`.

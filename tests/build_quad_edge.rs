@@ -4,7 +4,7 @@
 //!
 //! As in `tests/build_half_edge.rs`, the real binary writes its output folder into a
 //! temporary directory and the independent sheet checker of `tests/common` reads it
-//! back (every SVG; every DXF through ezdxf, only the first and the last for
+//! back (every SVG; every DXF read back, only the first and the last for
 //! fertility and horse_quad unless `UNFOLD_FULL_DXF=1`); the geometric facts are
 //! checked at library level on the pipeline of `src/run.rs` (`common::build::pipeline`),
 //! with the mesh the scheme used: counts against the mesh, holes followed back to 3D,

@@ -1,6 +1,6 @@
 //! End-to-end tests of the winged-edge scheme (SPEC.md §2): the same panel and
 //! connection counts as quad-edge, every sheet through the independent checker and every
-//! DXF through ezdxf, the holes of every connection meeting in 3D through the flat
+//! DXF read back, the holes of every connection meeting in 3D through the flat
 //! panels' maps (twice as many with half-length wings, which give two shared regions per
 //! corner), and golden files of the cube.
 //!
@@ -50,7 +50,7 @@ fn a_panel_per_edge_and_every_sheet_checks_for_every_shift() {
             let edges = count(&m, "input.edges");
             assert_eq!(count(&m, "counts.panels"), edges, "{what}: panels = E");
             assert_eq!(count(&m, "counts.connections"), 2 * edges, "{what}: 2E");
-            // The DXF writer does not depend on the shift: ezdxf (seconds per sheet)
+            // The DXF writer does not depend on the shift: ezdxf, where it runs (seconds per sheet),
             // reads the sheets of one shift per model.
             let dxf = if shift == "0" {
                 DxfCheck::All

@@ -2,16 +2,20 @@
 //! DXF files: a valid sheet passes with hand-computed stats, and every kind of defect is
 //! rejected with a message that names it.
 //!
-//! The DXF tests need python3 with ezdxf (`pip install ezdxf`); with
-//! `UNFOLD_SKIP_EZDXF=1` and no ezdxf they are skipped.
+//! The DXF tests read every file with the Rust reader of `tests/common/dxf_read.rs` and,
+//! when python3 has ezdxf (`pip install ezdxf`; required with `UNFOLD_REQUIRE_EZDXF=1`),
+//! with `tests/check_dxf.py` as well: every defect must be caught by each.
 
 mod common;
 
 use std::f64::consts::PI;
-use std::process::Command;
 use std::time::Instant;
 
-use common::{check_dxf_matches_svg, check_svg_sheet, svg_circles, svg_geometry, SheetSpec};
+use common::dxf_read::{ezdxf_wanted, read_dxf, read_dxf_with_ezdxf, DEFAULT_LAYERS};
+use common::{
+    check_dxf_matches_svg, check_dxf_matches_svg_read_by, check_svg_sheet, svg_circles,
+    svg_geometry, DxfReader, SheetSpec,
+};
 
 const SPEC: SheetSpec = SheetSpec {
     width: 100.0,
@@ -539,14 +543,6 @@ fn round_trip_pair() -> (String, String) {
     (svg, dxf(&ents))
 }
 
-fn ezdxf_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import ezdxf"])
-        .status()
-        .map(|s| s.success())
-        .unwrap_or(false)
-}
-
 #[test]
 fn dxf_round_trip() {
     let dir = tempfile::tempdir().unwrap();
@@ -558,52 +554,132 @@ fn dxf_round_trip() {
     check_dxf_matches_svg(&good, &svg, 80.0).expect("matching DXF");
     eprintln!("DXF check took {:.3} s", t.elapsed().as_secs_f64());
 
-    if !ezdxf_available() {
-        eprintln!("ezdxf unavailable (UNFOLD_SKIP_EZDXF=1): negative DXF checks skipped");
-        return;
-    }
-    // geometry differs
-    let moved = svg.replace("M 12 15 L 38 15", "M 12 16 L 38 16");
-    let err = check_dxf_matches_svg(&good, &moved, 80.0).expect_err("moved score line");
-    assert!(err.contains("does not match"), "{err}");
-    assert!(err.contains("only in SVG: SCORE open polyline"), "{err}");
-    assert!(err.contains("only in DXF: SCORE open polyline"), "{err}");
-    // y not flipped
-    let err = check_dxf_matches_svg(&good, &svg, 0.0).expect_err("wrong height");
-    assert!(err.contains("does not match"), "{err}");
-    // a missing circle
-    let no_hole = svg.replace(&circle("20", "20", "2", RED), "");
-    let err = check_dxf_matches_svg(&good, &no_hole, 80.0).expect_err("extra circle");
-    assert!(err.contains("only in DXF: CUT circle"), "{err}");
+    // The group codes as unfold writes them, right-aligned in three columns.
+    let padded: String = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| {
+            if i % 2 == 0 {
+                format!("{l:>3}\n")
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    let padded_path = dir.path().join("padded.dxf");
+    std::fs::write(&padded_path, &padded).unwrap();
+    check_dxf_matches_svg(&padded_path, &svg, 80.0).expect("right-aligned group codes");
 
-    // files the DXF checker itself must reject
-    let bad_files = [
-        (
-            text.replace("0\nSEQEND\n8\nSCORE\n", ""),
-            "not ended by SEQEND",
-        ),
-        (
-            text.replace(
-                "0\nENDSEC\n0\nEOF",
-                "0\nTEXT\n8\nENGRAVE\n62\n7\n10\n1.0\n20\n1.0\n40\n2.0\n1\nA\n0\nENDSEC\n0\nEOF",
+    let rust = read_dxf(&good, &DEFAULT_LAYERS).expect("the Rust reader reads the sheet");
+    assert_eq!(rust.entities.len(), 4);
+    let mut readers = vec![DxfReader::Rust];
+    if ezdxf_wanted().expect("ezdxf when required") {
+        // Both readers see the same entities.
+        assert_eq!(
+            rust.entities,
+            read_dxf_with_ezdxf(&good).expect("ezdxf reads the sheet")
+        );
+        readers.push(DxfReader::Ezdxf);
+    }
+
+    for reader in readers {
+        let check = |path: &std::path::Path, svg: &str, height: f64| {
+            check_dxf_matches_svg_read_by(reader, path, svg, height)
+        };
+        check(&good, &svg, 80.0).unwrap_or_else(|e| panic!("{reader:?}: matching DXF: {e}"));
+        // geometry differs
+        let moved = svg.replace("M 12 15 L 38 15", "M 12 16 L 38 16");
+        let err = check(&good, &moved, 80.0).expect_err("moved score line");
+        assert!(err.contains("does not match"), "{reader:?}: {err}");
+        assert!(
+            err.contains("only in SVG: SCORE open polyline"),
+            "{reader:?}: {err}"
+        );
+        assert!(
+            err.contains("only in DXF: SCORE open polyline"),
+            "{reader:?}: {err}"
+        );
+        // y not flipped
+        let err = check(&good, &svg, 0.0).expect_err("wrong height");
+        assert!(err.contains("does not match"), "{reader:?}: {err}");
+        // a missing circle
+        let no_hole = svg.replace(&circle("20", "20", "2", RED), "");
+        let err = check(&good, &no_hole, 80.0).expect_err("extra circle");
+        assert!(err.contains("only in DXF: CUT circle"), "{reader:?}: {err}");
+
+        // files the DXF checker itself must reject
+        let score_end = "10\n38\n20\n65\n30\n0.0\n";
+        assert!(text.contains(score_end));
+        let engrave_line = "0\nLINE\n8\nENGRAVE\n62\n7\n";
+        assert!(text.contains(engrave_line));
+        let bad_files = [
+            (
+                text.replace("0\nSEQEND\n8\nSCORE\n", ""),
+                "not ended by SEQEND",
             ),
-            "unexpected entity type TEXT",
-        ),
-        (text.replace("AC1009", "AC1015"), "AC1009"),
-        (
-            text.replace("2\nSCORE\n70\n0\n62\n5", "2\nSCORE\n70\n0\n62\n3"),
-            "colour",
-        ),
-        (text.replace("0\nEOF\n", ""), "EOF"),
-        (
-            text.replacen("62\n1\n66", "62\n3\n66", 1),
-            "has colour 3, expected 1",
-        ),
-    ];
-    for (i, (bad, word)) in bad_files.iter().enumerate() {
-        let p = dir.path().join(format!("bad-{i}.dxf"));
-        std::fs::write(&p, bad).unwrap();
-        let err = check_dxf_matches_svg(&p, &svg, 80.0).expect_err(word);
-        assert!(err.contains(word), "expected {word:?} in: {err}");
+            (
+                text.replace(
+                    "0\nENDSEC\n0\nEOF",
+                    "0\nTEXT\n8\nENGRAVE\n62\n7\n10\n1.0\n20\n1.0\n40\n2.0\n1\nA\n0\nENDSEC\n0\nEOF",
+                ),
+                "unexpected entity type TEXT",
+            ),
+            (text.replace("AC1009", "AC1015"), "AC1009"),
+            (
+                text.replace("2\nSCORE\n70\n0\n62\n5", "2\nSCORE\n70\n0\n62\n3"),
+                "colour",
+            ),
+            (
+                text.replace("2\nSCORE\n70\n0\n62\n5", "2\nSCORE\n70\n0\n62\n-5"),
+                "layer SCORE has colour -5, expected 5",
+            ),
+            (text.replace("0\nEOF\n", ""), "EOF"),
+            (
+                text.replace(
+                    "0\nENDSEC\n0\nSECTION\n2\nENTITIES\n",
+                    "0\nSECTION\n2\nENTITIES\n",
+                ),
+                "ENDSEC",
+            ),
+            (
+                text.replacen("62\n1\n66", "62\n3\n66", 1),
+                "has colour 3, expected 1",
+            ),
+            (
+                text.replace(engrave_line, "0\nLINE\n8\nENGRAVE\n"),
+                "no colour of its own",
+            ),
+            (
+                text.replace(engrave_line, "0\nLINE\n8\nMARK\n62\n7\n"),
+                "not defined in the LAYER table",
+            ),
+            (
+                text.replace(engrave_line, "0\nLINE\n8\nENGRAVE\n67\n1\n62\n7\n"),
+                "paper space",
+            ),
+            (
+                text.replace(score_end, &format!("{score_end}42\n0.5\n")),
+                "bulge",
+            ),
+            (
+                text.replacen("70\n0\n0\nVERTEX", "70\n16\n0\nVERTEX", 1),
+                "polyface/mesh",
+            ),
+            (
+                text.replace("2\nENGRAVE\n70\n0", "2\nENGRAVE\n100\nAcDbSymbolTableRecord\n70\n0"),
+                "subclass marker",
+            ),
+            (text.replace("Solid line", "Solid l\u{e9}ne"), "non-ASCII"),
+        ];
+        for (i, (bad, word)) in bad_files.iter().enumerate() {
+            assert_ne!(bad, &text, "{word}: the defect is in the file");
+            let p = dir.path().join(format!("bad-{i}.dxf"));
+            std::fs::write(&p, bad).unwrap();
+            let err = check(&p, &svg, 80.0).expect_err(word);
+            assert!(
+                err.contains(word),
+                "{reader:?}: expected {word:?} in: {err}"
+            );
+        }
     }
 }

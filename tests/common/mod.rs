@@ -10,8 +10,10 @@
 //! * [`parse_svg`] — the parser alone (syntax checks only), returning an [`SvgSheet`].
 //! * [`svg_geometry`] / [`svg_circles`] — paths and circles of a sheet (panic on a
 //!   malformed file: for tests that already checked the sheet).
-//! * [`check_dxf_matches_svg`] — runs `tests/check_dxf.py` (ezdxf, strict read + audit)
-//!   on a DXF and compares its entities with the SVG geometry (y flipped).
+//! * [`check_dxf_matches_svg`] — reads a DXF back with the Rust reader of [`dxf_read`]
+//!   (R12 conventions on the raw group codes, then the `dxf` crate) and, when python3 has
+//!   ezdxf, with `tests/check_dxf.py` (ezdxf, strict read + audit), and compares the
+//!   entities of each read with the SVG geometry (y flipped).
 //! * [`build`] — helpers for the end-to-end build tests of every scheme (running the
 //!   binary, reading the manifest, checking an output folder, the library's pipeline up
 //!   to the flat panels, golden files).
@@ -22,10 +24,12 @@
 
 pub mod build;
 pub mod corpus;
+pub mod dxf_read;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
-use std::process::Command;
+
+use dxf_read::DxfEntity;
 
 /// A point in sheet millimetres (SVG coordinates: y down unless said otherwise).
 pub type Pt = (f64, f64);
@@ -1455,24 +1459,17 @@ impl Item {
     }
 }
 
-fn json_pt(v: &serde_json::Value) -> Option<Pt> {
-    let a = v.as_array()?;
-    Some((a.first()?.as_f64()?, a.get(1)?.as_f64()?))
-}
-
-fn dxf_items(json: &serde_json::Value) -> Result<Vec<Item>, String> {
-    let list = json
-        .as_array()
-        .ok_or("check_dxf.py output is not a JSON list")?;
+/// The comparison items of a DXF's entities: every entity on a layer of the default
+/// names and with that layer's colour as its own.
+fn dxf_items(entities: &[DxfEntity]) -> Result<Vec<Item>, String> {
     let mut items = Vec::new();
-    for (i, e) in list.iter().enumerate() {
-        let field = |k: &str| e.get(k).unwrap_or(&serde_json::Value::Null);
-        let ty = field("type").as_str().unwrap_or("?");
-        let layer_name = field("layer").as_str().unwrap_or("?");
+    for (i, e) in entities.iter().enumerate() {
+        let ty = e.kind.as_str();
+        let layer_name = e.layer.as_str();
         let layer = Layer::from_name(layer_name).ok_or(format!(
             "DXF entity #{i} ({ty}) is on layer {layer_name:?}; expected CUT, SCORE, SCORE-VALLEY or ENGRAVE"
         ))?;
-        match field("color").as_i64() {
+        match e.color {
             Some(c) if c == layer.dxf_color() => {}
             Some(c) => {
                 return Err(format!(
@@ -1482,32 +1479,24 @@ fn dxf_items(json: &serde_json::Value) -> Result<Vec<Item>, String> {
             }
             None => {
                 return Err(format!(
-                    "DXF entity #{i} ({ty}) on layer {layer_name} has no colour (group 62); expected {}",
+                    "DXF entity #{i} ({ty}) on layer {layer_name} has no colour of its own (group 62); expected {}",
                     layer.dxf_color()
                 ))
             }
         }
-        let bad = || format!("DXF entity #{i} ({ty}): malformed checker output {e}");
         match ty {
-            "POLYLINE" | "LINE" => {
-                let closed = field("closed").as_bool().ok_or_else(bad)?;
-                let pts: Vec<Pt> = field("points")
-                    .as_array()
-                    .ok_or_else(bad)?
-                    .iter()
-                    .map(json_pt)
-                    .collect::<Option<_>>()
-                    .ok_or_else(bad)?;
-                items.push(Item {
-                    layer,
-                    circle: false,
-                    closed,
-                    pts: normalize(pts, closed),
-                });
-            }
+            "POLYLINE" | "LINE" => items.push(Item {
+                layer,
+                circle: false,
+                closed: e.closed,
+                pts: normalize(e.points.clone(), e.closed),
+            }),
             "CIRCLE" => {
-                let c = json_pt(field("center")).ok_or_else(bad)?;
-                let r = field("radius").as_f64().ok_or_else(bad)?;
+                let (Some(c), Some(r)) = (e.center, e.radius) else {
+                    return Err(format!(
+                        "DXF entity #{i}: a CIRCLE without centre or radius"
+                    ));
+                };
                 items.push(Item {
                     layer,
                     circle: true,
@@ -1571,53 +1560,51 @@ fn match_items(left: &[Item], right: &[Item]) -> (Vec<Item>, Vec<Item>) {
     (unmatched_left, unmatched_right)
 }
 
-/// Runs `python3 tests/check_dxf.py DXF` (strict ezdxf read + audit + R12 conventions) and
-/// checks that the DXF holds the same geometry as the SVG: the same multiset of
-/// (layer, closed, points) polylines — LINE entities count as open two-point polylines —
-/// and (layer, centre, radius) circles, with SVG y flipped to `height − y` and
-/// coordinates equal within 1e-3 mm, points in the same order. Every entity must carry
-/// its layer's colour (CUT 1, SCORE 5, SCORE-VALLEY 3, ENGRAVE 7).
-///
-/// If python3 or ezdxf is missing this fails with installation advice, unless
-/// `UNFOLD_SKIP_EZDXF=1`, in which case it prints a skip notice and returns Ok.
+/// Which reader [`check_dxf_matches_svg_read_by`] reads the DXF with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DxfReader {
+    /// [`dxf_read::read_dxf`]: R12 conventions on the raw group codes, then the `dxf` crate.
+    Rust,
+    /// `tests/check_dxf.py`: ezdxf's strict read and audit, and the R12 conventions.
+    Ezdxf,
+}
+
+/// Checks that a DXF sheet holds the same geometry as its SVG, read back by the Rust
+/// reader on every machine and, when python3 has ezdxf, by ezdxf as well (see
+/// [`check_dxf_matches_svg_read_by`]). Without ezdxf this fails when
+/// `UNFOLD_REQUIRE_EZDXF=1` (as in CI) and otherwise prints one notice per test process.
 pub fn check_dxf_matches_svg(dxf_path: &Path, svg_text: &str, height: f64) -> Result<(), String> {
+    check_dxf_matches_svg_read_by(DxfReader::Rust, dxf_path, svg_text, height)?;
+    if dxf_read::ezdxf_wanted()? {
+        check_dxf_matches_svg_read_by(DxfReader::Ezdxf, dxf_path, svg_text, height)?;
+    }
+    Ok(())
+}
+
+/// Reads the DXF with `reader` (which also checks the R12 conventions: 7-bit ASCII,
+/// $ACADVER AC1009, no group 100, POLYLINE … VERTEX* … SEQEND, layers CUT, SCORE,
+/// SCORE-VALLEY, ENGRAVE with colours 1, 5, 3, 7, only POLYLINE, LINE and CIRCLE in
+/// modelspace) and checks that it holds the same geometry as the SVG: the same multiset
+/// of (layer, closed, points) polylines — LINE entities count as open two-point
+/// polylines — and (layer, centre, radius) circles, with SVG y flipped to `height − y`
+/// and coordinates equal within 1e-3 mm, points in the same order. Every entity must
+/// carry its layer's colour.
+pub fn check_dxf_matches_svg_read_by(
+    reader: DxfReader,
+    dxf_path: &Path,
+    svg_text: &str,
+    height: f64,
+) -> Result<(), String> {
     let sheet = parse_svg(svg_text).map_err(|e| format!("SVG does not parse: {e}"))?;
-    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests")
-        .join("check_dxf.py");
-    let skip = std::env::var("UNFOLD_SKIP_EZDXF").is_ok_and(|v| v == "1");
-    let unavailable = |why: String| -> Result<(), String> {
-        if skip {
-            eprintln!(
-                "UNFOLD_SKIP_EZDXF=1: skipping the DXF check of {} ({why})",
-                dxf_path.display()
-            );
-            Ok(())
-        } else {
-            Err(format!(
-                "{why}\nthe DXF check needs python3 with ezdxf: install it with `pip install ezdxf` \
-                 (or set UNFOLD_SKIP_EZDXF=1 to skip DXF checks)"
-            ))
-        }
+    let (entities, by) = match reader {
+        DxfReader::Rust => (
+            dxf_read::read_dxf(dxf_path, &dxf_read::DEFAULT_LAYERS)?.entities,
+            "the Rust reader",
+        ),
+        DxfReader::Ezdxf => (dxf_read::read_dxf_with_ezdxf(dxf_path)?, "ezdxf"),
     };
-    let out = match Command::new("python3").arg(&script).arg(dxf_path).output() {
-        Ok(o) => o,
-        Err(e) => return unavailable(format!("cannot run python3: {e}")),
-    };
-    let stderr = String::from_utf8_lossy(&out.stderr).trim().to_string();
-    if out.status.code() == Some(3) {
-        return unavailable(stderr);
-    }
-    if !out.status.success() {
-        return Err(format!(
-            "DXF {} rejected by tests/check_dxf.py ({}): {stderr}",
-            dxf_path.display(),
-            out.status
-        ));
-    }
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout)
-        .map_err(|e| format!("check_dxf.py printed invalid JSON: {e}"))?;
-    let dxf = dxf_items(&json)?;
+    let dxf =
+        dxf_items(&entities).map_err(|e| format!("{} (read by {by}): {e}", dxf_path.display()))?;
 
     let mut svg: Vec<Item> = sheet
         .paths
@@ -1641,7 +1628,7 @@ pub fn check_dxf_matches_svg(dxf_path: &Path, svg_text: &str, height: f64) -> Re
         return Ok(());
     }
     let mut msg = format!(
-        "DXF {} does not match the SVG ({} SVG items, {} DXF entities; coordinates compared after y' = {height} - y, tolerance {TOL}):",
+        "DXF {} (read by {by}) does not match the SVG ({} SVG items, {} DXF entities; coordinates compared after y' = {height} - y, tolerance {TOL}):",
         dxf_path.display(),
         svg.len(),
         dxf.len()
