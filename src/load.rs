@@ -7,25 +7,15 @@ use crate::config::ModelSettings;
 use crate::error::{self, InputError, Result};
 use crate::mesh::{self, components::SmallComponents, Note, PrepareOptions, PreparedModel};
 
-/// What to do when a simplification budget was refused: the smallest budget found
-/// that works, or building without simplification.
-fn refused_budget_fix(
-    mesh: &mesh::Mesh,
-    budget: mesh::simplify::Budget,
-    mode: mesh::simplify::SimplifyMode,
-) -> String {
-    use mesh::simplify::Budget;
-    match mesh::simplify::smallest_working_budget(mesh, budget, mode) {
-        Some(Budget::Edges(n)) => {
-            format!("the smallest budget found that keeps it is --target-edges {n}")
-        }
-        Some(Budget::Faces(n)) => {
-            format!("the smallest budget found that keeps it is --target-faces {n}")
-        }
-        None => format!(
-            "no budget below the model's own {} edges keeps it; build it without --target-edges",
-            mesh.edge_count()
+/// What to do when a simplification budget was refused: the fewest edges or faces the
+/// topology allows, or building without simplification.
+fn refused_budget_fix(error: &mesh::simplify::SimplifyError) -> String {
+    use mesh::simplify::SimplifyError;
+    match error {
+        SimplifyError::BelowMinimum { what, fewest, .. } => format!(
+            "give --target-{what} {fewest} or more"
         ),
+        _ => "build it without --target-edges; this is a bug in unfold: please report it with the model file".to_string(),
     }
 }
 
@@ -49,14 +39,14 @@ pub fn load_model(
         let (simplified, report) =
             mesh::simplify::simplify(&prepared.mesh, budget, settings.simplify_mode).map_err(
                 |e| {
-                    let fix = refused_budget_fix(&prepared.mesh, budget, settings.simplify_mode);
+                    let fix = refused_budget_fix(&e);
                     InputError::new(path, error::Location::File, e.to_string(), fix)
                 },
             )?;
         let mode = match report.fallback {
             None => format!("{} mode", settings.simplify_mode),
             Some(used) => format!(
-                "{} mode did not keep the topology, so {used} was used",
+                "{} mode; meshoptimizer's result did not keep the topology or the budget, so {used} were used",
                 settings.simplify_mode
             ),
         };

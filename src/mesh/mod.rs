@@ -6,6 +6,7 @@
 
 pub mod build;
 pub mod components;
+pub mod decimate;
 pub mod distance;
 pub mod ergs;
 pub mod geometry;

@@ -1,13 +1,17 @@
-//! Simplification to a panel budget through meshoptimizer's edge-collapse simplifier
-//! (faces with more than three corners are triangulated first). Border vertices only
-//! collapse along their border, so holes stay holes; the result is rebuilt by the
-//! ordinary half-edge builder and refused if it is not a manifold of the same genus
-//! with the same number of boundary loops (in regular mode, once the lighter
-//! regularization and no regularization have been tried as well). In regular mode the
-//! result is then relaxed toward even edges ([`super::relax`]), and kept relaxed only
-//! if its deviation from the original surface, measured again, did not grow.
+//! Simplification to a panel budget (faces with more than three corners are
+//! triangulated first). meshoptimizer's edge-collapse simplifier is tried first, in the
+//! mode asked for; it does not check the link condition, so its result is rebuilt by
+//! the ordinary half-edge builder and kept only if it is a manifold of the same genus,
+//! boundary loops and components, within 2 % of an edge budget. Otherwise the
+//! project's own decimator ([`super::decimate`]), which keeps the topology by
+//! construction, makes the result: any budget down to the topological minimum is
+//! reached. Border vertices only move along their border, so holes stay holes. In
+//! regular mode the result is then relaxed toward even edges ([`super::relax`]), and
+//! kept relaxed only if its deviation from the original surface, measured again, did
+//! not grow.
 
 use super::build::build_mesh;
+use super::decimate::{decimate, Goal};
 use super::halfedge::Mesh;
 use super::polygons::Polygons;
 use super::relax::{relax, Surface};
@@ -86,38 +90,22 @@ pub enum SimplifyError {
     /// The simplified triangles do not build into a valid mesh.
     #[error("simplifying that far does not give a valid manifold ({0})")]
     Invalid(String),
-}
-
-/// After `asked` was refused: the smallest budget of the same kind found to simplify
-/// `mesh` while keeping its topology, searched by growing the budget by half until one
-/// works, then bisecting down to 2 %. `None` when no budget below the mesh's own
-/// count works.
-pub fn smallest_working_budget(mesh: &Mesh, asked: Budget, mode: SimplifyMode) -> Option<Budget> {
-    let (asked, make, limit): (usize, fn(usize) -> Budget, usize) = match asked {
-        Budget::Edges(n) => (n, Budget::Edges, mesh.edge_count()),
-        Budget::Faces(n) => (n, Budget::Faces, mesh.face_count()),
-    };
-    let works = |n: usize| simplify(mesh, make(n), mode).is_ok();
-    let (mut failed, mut next) = (asked, asked);
-    let mut worked = loop {
-        next = (next + next / 2).max(next + 1);
-        if next >= limit {
-            return None;
-        }
-        if works(next) {
-            break next;
-        }
-        failed = next;
-    };
-    while worked - failed > (worked / 50).max(1) {
-        let mid = failed + (worked - failed) / 2;
-        if works(mid) {
-            worked = mid;
-        } else {
-            failed = mid;
-        }
-    }
-    Some(make(worked))
+    /// The budget is below the fewest edges the topology allows.
+    #[error("{asked} {what} is fewer than this model's topology allows: keeping its genus {genus}, {loops} boundary {} and {components} {} takes at least {fewest} {what}", if *loops == 1 { "loop" } else { "loops" }, if *components == 1 { "part" } else { "parts" })]
+    BelowMinimum {
+        /// "edges" or "faces".
+        what: &'static str,
+        /// The budget asked for.
+        asked: usize,
+        /// The fewest reached while keeping the topology.
+        fewest: usize,
+        /// The mesh's genus.
+        genus: i64,
+        /// Its boundary loops.
+        loops: usize,
+        /// Its connected parts.
+        components: usize,
+    },
 }
 
 /// Simplifies a triangle mesh toward `budget`. Deterministic: meshoptimizer is
@@ -214,32 +202,34 @@ pub fn simplify(
             samples: &samples,
         }),
     };
-    // Regularizing collapses across thin handles more readily (fertility at 600
-    // edges loses one of its four): when its result changes the topology or does not
-    // build into a manifold, the lighter regularization and then none are tried, and
-    // the report says so.
-    let attempts: &[(meshopt::SimplifyOptions, Option<&'static str>)] = match mode {
-        SimplifyMode::Regular => &[
-            (meshopt::SimplifyOptions::Regularize, None),
-            (
-                meshopt::SimplifyOptions::RegularizeLight,
-                Some("light regularization"),
-            ),
-            (meshopt::SimplifyOptions::empty(), Some("no regularization")),
-        ],
-        SimplifyMode::Accurate => &[(meshopt::SimplifyOptions::empty(), None)],
+    let options = match mode {
+        SimplifyMode::Regular => meshopt::SimplifyOptions::Regularize,
+        SimplifyMode::Accurate => meshopt::SimplifyOptions::empty(),
     };
-    let mut failure = None;
-    for &(options, fallback) in attempts {
-        match input.attempt(options) {
-            Ok((simplified, mut report)) => {
-                report.fallback = fallback;
-                return Ok((simplified, report));
-            }
-            Err(e) => failure = Some(e),
+    if let Ok(done) = input.rebuild(&input.simplified_triangles(options)) {
+        if input.reached(&done.1) {
+            return Ok(done);
         }
     }
-    Err(failure.expect("at least one attempt"))
+    // meshoptimizer glued the surface to itself, closed a hole, lost a part or stopped
+    // short: decimate with the link condition instead.
+    let (simplified, mut report) = input.decimated(mode)?;
+    if !input.reached(&report) {
+        let (what, asked, fewest) = match budget {
+            Budget::Edges(n) => ("edges", n, report.after.1),
+            Budget::Faces(n) => ("faces", n, report.after.0),
+        };
+        return Err(SimplifyError::BelowMinimum {
+            what,
+            asked,
+            fewest,
+            genus: input.before.genus,
+            loops: input.before.boundary_loops,
+            components: input.before.components.len(),
+        });
+    }
+    report.fallback = Some("edge collapses that keep the topology");
+    Ok((simplified, report))
 }
 
 /// The triangles to simplify and what to aim for.
@@ -260,14 +250,6 @@ struct Input<'a> {
 }
 
 impl Input<'_> {
-    /// One simplification with meshoptimizer's `options`, checked.
-    fn attempt(
-        &self,
-        options: meshopt::SimplifyOptions,
-    ) -> Result<(Mesh, SimplifyReport), SimplifyError> {
-        self.rebuild(&self.simplified_triangles(options))
-    }
-
     /// The simplifier's triangles for `options`, its target corrected a few times
     /// toward an edge budget.
     fn simplified_triangles(&self, options: meshopt::SimplifyOptions) -> Vec<u32> {
@@ -306,10 +288,56 @@ impl Input<'_> {
         out
     }
 
-    /// The mesh of the simplifier's triangles `out`, refused unless it is a manifold
-    /// of the same topology, with its report.
+    /// Whether `report`'s result is within 2 % of the budget, or within the three
+    /// edges (two faces) one collapse removes.
+    fn reached(&self, report: &SimplifyReport) -> bool {
+        match self.budget {
+            Budget::Edges(n) => report.after.1.abs_diff(n) <= (n / 50).max(3),
+            Budget::Faces(n) => report.after.0.abs_diff(n) <= (n / 50).max(2),
+        }
+    }
+
+    /// The project's decimator's result for `mode`, checked and measured.
+    fn decimated(&self, mode: SimplifyMode) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+        let mesh = self.mesh;
+        let (positions, triangles) = manifold_triangles(mesh);
+        let mut locked = self.locked.to_vec();
+        locked.resize(positions.len(), false);
+        let goal = match mode {
+            SimplifyMode::Regular => Goal::Regular,
+            SimplifyMode::Accurate => Goal::Accurate,
+        };
+        let target_edges = match self.budget {
+            Budget::Edges(n) => n,
+            // 3F = 2E − b for triangles.
+            Budget::Faces(n) => (3 * n + self.before.boundary_edges).div_ceil(2),
+        };
+        let out = decimate(&positions, &triangles, &locked, target_edges, goal);
+        // A centre added to a face continues the face's first corner.
+        let first_corners: Vec<u32> = mesh
+            .faces()
+            .filter(|&f| mesh.face_degree(f) > 3)
+            .map(|f| mesh.face_vertices(f).next().map_or(0, |v| v.0))
+            .collect();
+        let source: Vec<u32> = out
+            .source
+            .iter()
+            .map(|&v| {
+                let v = match (v as usize).checked_sub(mesh.vertex_count()) {
+                    Some(centre) => first_corners.get(centre).copied().unwrap_or(0),
+                    None => v,
+                };
+                mesh.vertex_source(super::ids::VertexId(v))
+            })
+            .collect();
+        self.finish(Polygons::from_faces(out.positions, &out.triangles), &source)
+    }
+
+    /// The mesh of meshoptimizer's triangles `out` (indices into the input's
+    /// vertices), refused unless it is a manifold of the same topology, with its
+    /// report.
     fn rebuild(&self, out: &[u32]) -> Result<(Mesh, SimplifyReport), SimplifyError> {
-        let (mesh, indices, before) = (self.mesh, self.indices, &self.before);
+        let mesh = self.mesh;
         // A collapse can fold two triangles onto each other (the same three vertices, once
         // each way round): that pocket encloses nothing and gives its edges four faces.
         // Remove both copies, and any triangle that lost a corner.
@@ -332,15 +360,30 @@ impl Input<'_> {
                     .collect::<Vec<_>>(),
             );
         }
+        self.finish(polys, &source)
+    }
+
+    /// The mesh of the simplified triangles `polys` (whose vertices came from the
+    /// input's `source`), refused unless it is a manifold of the input's genus,
+    /// boundary loops and parts; relaxed in regular mode; with its report.
+    fn finish(
+        &self,
+        polys: Polygons,
+        source: &[u32],
+    ) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+        let (indices, before) = (self.indices, &self.before);
         let face_source: Vec<u32> = vec![u32::MAX; polys.face_count()];
         let build = |polys: &Polygons| {
-            build_mesh(polys, Some(&source), Some(&face_source))
+            build_mesh(polys, Some(source), Some(&face_source))
                 .map(|(m, _)| m)
                 .map_err(|e| SimplifyError::Invalid(e.to_string()))
         };
         let mut simplified = build(&polys)?;
         let after = simplified.topology();
-        if after.genus != before.genus || after.boundary_loops != before.boundary_loops {
+        if after.genus != before.genus
+            || after.boundary_loops != before.boundary_loops
+            || after.components.len() != before.components.len()
+        {
             return Err(SimplifyError::Topology {
                 faces: after.faces,
                 genus_before: before.genus,
@@ -392,6 +435,74 @@ impl Input<'_> {
         };
         Ok((simplified, report))
     }
+}
+
+/// The mesh's faces as triangles that form an oriented manifold, as the decimator
+/// needs: a face of more than three corners is split along diagonals that are no edge
+/// of the mesh and no diagonal of another face (its own triangulation, else a fan from
+/// one of its corners); where every split would repeat an edge, it is fanned from a
+/// new vertex at its centre (appended after the mesh's vertices, one slot for each face
+/// of more than three corners, in face order, whether used or not).
+fn manifold_triangles(mesh: &Mesh) -> (Vec<glam::DVec3>, Vec<[u32; 3]>) {
+    use std::collections::HashSet;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let mut edges: HashSet<(u32, u32)> = mesh
+        .edges()
+        .map(|e| {
+            let (a, b) = mesh.edge_vertices(e);
+            key(a.0, b.0)
+        })
+        .collect();
+    let mut positions = mesh.positions().to_vec();
+    let mut triangles = Vec::with_capacity(2 * mesh.face_count());
+    let mut centre_slot = mesh.vertex_count() as u32;
+    for f in mesh.faces() {
+        let corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+        let n = corners.len();
+        if n == 3 {
+            triangles.push([corners[0], corners[1], corners[2]]);
+            continue;
+        }
+        let points: Vec<glam::DVec3> = mesh.face_positions(f).collect();
+        let own: Vec<[usize; 3]> = super::split::triangulate(&points);
+        let fans = (0..n).map(|k| -> Vec<[usize; 3]> {
+            (1..n - 1)
+                .map(|j| [k, (k + j) % n, (k + j + 1) % n])
+                .collect()
+        });
+        // A split is fresh when none of its diagonals is already an edge.
+        let fresh = |split: &Vec<[usize; 3]>, edges: &HashSet<(u32, u32)>| {
+            split.iter().all(|t| {
+                (0..3).all(|i| {
+                    let (a, b) = (t[i], t[(i + 1) % 3]);
+                    let side = (a + 1) % n == b || (b + 1) % n == a;
+                    side || !edges.contains(&key(corners[a], corners[b]))
+                })
+            })
+        };
+        let slot = centre_slot;
+        centre_slot += 1;
+        match std::iter::once(own).chain(fans).find(|s| fresh(s, &edges)) {
+            Some(split) => {
+                for t in &split {
+                    for i in 0..3 {
+                        edges.insert(key(corners[t[i]], corners[t[(i + 1) % 3]]));
+                    }
+                    triangles.push(t.map(|k| corners[k]));
+                }
+            }
+            None => {
+                positions.resize(slot as usize + 1, glam::DVec3::ZERO);
+                positions[slot as usize] = points.iter().sum::<glam::DVec3>() / n as f64;
+                for i in 0..n {
+                    triangles.push([corners[i], corners[(i + 1) % n], slot]);
+                }
+            }
+        }
+    }
+    // The slots of faces split along diagonals hold no vertex; the decimator drops
+    // vertices no triangle uses.
+    (positions, triangles)
 }
 
 /// The longest edge length and the 95th-percentile one, each over the median.
