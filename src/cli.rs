@@ -79,15 +79,22 @@ enum Command {
 /// Runs the command line `args` (the program name first) with the schemes of
 /// `registry`, printing to stdout and stderr, and returns the exit code.
 pub fn main(registry: &Registry, args: impl IntoIterator<Item = OsString>) -> ExitCode {
+    let args: Vec<OsString> = args.into_iter().collect();
     let command = BuildOptions::with_registry(Cli::command(), registry);
-    let parsed = command.try_get_matches_from(args).and_then(|matches| {
+    let parsed = command.try_get_matches_from(&args).and_then(|matches| {
         let mut cli = Cli::from_arg_matches(&matches)?;
         cli.build.scheme_values = BuildOptions::scheme_values(&matches, registry);
         Ok(cli)
     });
     let cli = match parsed {
         Ok(cli) => cli,
-        Err(e) => return usage_error(e),
+        Err(e) => match spaced_length(&args) {
+            Some(hint) => {
+                eprintln!("unfold: error: {hint}");
+                return ExitCode::from(2);
+            }
+            None => return usage_error(e),
+        },
     };
     match crate::internal::catch(|| run(cli, registry)) {
         Ok(()) => ExitCode::SUCCESS,
@@ -108,6 +115,23 @@ pub fn main(registry: &Registry, args: impl IntoIterator<Item = OsString>) -> Ex
             ExitCode::from(e.exit_code() as u8)
         }
     }
+}
+
+/// An option's length written with a space before its unit (`--size 4 ft`), which the
+/// shell splits in two: the message a user needs instead of clap's about a stray
+/// argument.
+fn spaced_length(args: &[OsString]) -> Option<String> {
+    args.windows(3).find_map(|w| {
+        let (option, number, unit) = (w[0].to_str()?, w[1].to_str()?, w[2].to_str()?);
+        let spaced = option.starts_with("--")
+            && number.parse::<f64>().is_ok()
+            && crate::units::LengthUnit::parse_suffix(unit).is_some();
+        spaced.then(|| {
+            format!(
+                "{option} {number} {unit}: write a length without a space before its unit: {option} {number}{unit}"
+            )
+        })
+    })
 }
 
 /// Help and version go to stdout as clap renders them. Any other parse error keeps

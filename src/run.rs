@@ -645,7 +645,10 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let nested = nest(job, &flat, &|done| progress.set(done))?;
     progress.set(1.0);
     clock.lap("nest");
-    progress.bar(&format!("writing {} sheets", nested.layout.sheets));
+    progress.bar(&format!(
+        "writing {}",
+        crate::units::count_of(nested.layout.sheets, "sheet")
+    ));
     let warnings: Vec<String> = prepared
         .warnings
         .iter()

@@ -97,8 +97,13 @@ pub fn check_size(job: &Job, mesh: &Mesh) -> Result<SizeCheck> {
     let sheets = area / (usable_w * usable_h);
     if sheets > LARGE_SHEETS {
         let size = longest * (FEW_SHEETS / sheets).sqrt();
+        let fix = if forgot_size {
+            "give the size to build with --size"
+        } else {
+            "give a smaller --size"
+        };
         warnings.push(format!(
-            "{model} is built {across}: its surface alone covers {:.0} sheets of {}; give the size to build with --size (at --size {} it covers about {FEW_SHEETS:.0}) or use a larger --sheet",
+            "{model} is built {across}: its surface alone covers {:.0} sheets of {}; {fix} (at --size {} it covers about {FEW_SHEETS:.0}) or use a larger --sheet",
             sheets.ceil(),
             job.sheet.name,
             length_text(size)

@@ -149,6 +149,15 @@ pub(crate) fn fmt_path_length(mm: f64) -> String {
     }
 }
 
+/// A count with its noun, singular for one ("1 sheet", "2 sheets").
+pub(crate) fn count_of(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 /// A number with at most 4 decimals, trailing zeros trimmed (for reports).
 pub(crate) fn fmt_num(x: f64) -> String {
     let s = format!("{x:.4}");

@@ -419,3 +419,23 @@ fn the_knight_gives_the_same_bytes_on_one_thread_and_two() {
         "the knight differs between 1 and 2 threads"
     );
 }
+
+#[test]
+fn one_sheet_is_one_sheet_in_the_report() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("tet");
+    let run = common::build::unfold([
+        model("tetrahedron").as_os_str(),
+        "--size".as_ref(),
+        "4in".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("laying bounding boxes in rows would take 1 sheet\n"),
+        "{}",
+        run.stderr
+    );
+}

@@ -147,7 +147,14 @@ fn a_model_large_for_the_sheet_is_refused_under_strict() {
             "sheets of 18x24in",
             "it covers about 20)",
             "or use a larger --sheet",
+            // The size was given: the fix is a smaller one.
+            "give a smaller --size (at --size",
         ],
+    );
+    assert!(
+        !run.stderr.contains("give the size to build"),
+        "{}",
+        run.stderr
     );
 }
 

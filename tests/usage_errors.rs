@@ -62,6 +62,11 @@ fn parser_errors_keep_the_parsers_help() {
             &["possible values: true-shape, shelf"],
         ),
         (
+            "a length split from its unit",
+            vec![&model, "--size", "4", "ft"],
+            &["--size 4 ft: write a length without a space before its unit: --size 4ft"],
+        ),
+        (
             "missing model",
             vec!["--size", "4ft"],
             &["required arguments were not provided", "<MODEL>", "Usage:"],
@@ -194,9 +199,23 @@ fn config_errors_name_the_line_the_key_and_the_fix() {
             &["unfold.toml:1:9:", "not a sheet size"],
         ),
         (
-            "TOML syntax",
+            "a sheet without quotes",
             "sheet = 18x24in\n",
-            &["unfold.toml:1:9:", "not valid TOML"],
+            &[
+                "unfold.toml:1:9:",
+                "sheet = 18x24in",
+                "write sheet = \"18x24in\"",
+            ],
+        ),
+        (
+            "a length without quotes",
+            "scheme = \"net\"\nsize = 4ft # tall\n",
+            &["unfold.toml:2:", "size = 4ft", "write size = \"4ft\""],
+        ),
+        (
+            "TOML syntax",
+            "sheet = [18\n",
+            &["unfold.toml:1:", "not valid TOML"],
         ),
         (
             "the first mistake in the file is reported",

@@ -14,6 +14,22 @@ use super::{parse_length, parse_sheet, BuildOptions, LayerSettings, ModelOptions
 use crate::error::{Error, Result};
 use crate::scheme::{OptionValues, Registry};
 
+/// The message for a length or sheet written without quotes on the line at `offset`
+/// (`size = 4ft`), which TOML cannot read as a number: the key and the quoted value.
+fn unquoted_length(text: &str, offset: usize) -> Option<String> {
+    let start = text[..offset.min(text.len())]
+        .rfind('\n')
+        .map_or(0, |i| i + 1);
+    let line = text[start..].lines().next()?;
+    let (key, value) = line.split_once('=')?;
+    let (key, value) = (key.trim(), value.split('#').next()?.trim());
+    let looks_like_text = !value.starts_with(['"', '\'', '[', '{'])
+        && (parse_length(value).is_ok() || parse_sheet(value).is_ok());
+    looks_like_text.then(|| {
+        format!("{key} = {value}: a length or a sheet is text in TOML: write {key} = \"{value}\"")
+    })
+}
+
 /// Reads a configuration file into options (every key optional); the schemes' own
 /// keys are those of `registry`.
 pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
@@ -30,10 +46,14 @@ pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
         Error::Usage(format!("--config {place}: {what}"))
     };
     let table = DeTable::parse(&text).map_err(|e| {
-        at(
-            e.span(),
-            format!("not valid TOML: {}", one_line(e.message())),
-        )
+        let unquoted = e.span().and_then(|span| unquoted_length(&text, span.start));
+        match unquoted {
+            Some(hint) => at(e.span(), hint),
+            None => at(
+                e.span(),
+                format!("not valid TOML: {}", one_line(e.message())),
+            ),
+        }
     })?;
     let options = options(registry);
     let scheme_keys: Vec<String> = registry

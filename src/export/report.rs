@@ -75,12 +75,12 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         .collect();
     let _ = writeln!(
         s,
-        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {} sheets",
+        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {}",
         m.nesting.nester,
         m.nesting.effort,
         m.nesting.seed,
         fills.join(" "),
-        m.nesting.shelf_sheets
+        crate::units::count_of(m.nesting.shelf_sheets, "sheet")
     );
     let _ = writeln!(
         s,
