@@ -253,6 +253,18 @@ pub struct Prepared {
     pub notes: Vec<String>,
     /// Findings about the build's size, each naming its fix.
     pub warnings: Vec<String>,
+    /// The budget the warnings suggest, once one needed it.
+    clean_budget: std::cell::OnceCell<Option<usize>>,
+}
+
+impl Prepared {
+    /// The budget at which the model, simplified, builds with nothing to warn of:
+    /// found (by trial builds) the first time a warning asks.
+    pub fn clean_budget(&self, job: &Job) -> Option<usize> {
+        *self.clean_budget.get_or_init(|| {
+            crate::sanity::clean_budget(job, &self.scheme_mesh.mesh, &|n| model_at(job, n))
+        })
+    }
 }
 
 /// The flat panels with their labels fitted.
@@ -277,6 +289,16 @@ pub struct Nested {
     pub spacing_bound: usize,
     /// Observations for the report.
     pub notes: Vec<String>,
+}
+
+/// The job's model simplified to `edges` as `--target-edges` would do it, scaled and
+/// split for the scheme: what a warning's suggested budget is tried on.
+fn model_at(job: &Job, edges: usize) -> Option<crate::mesh::Mesh> {
+    let mut trial = job.clone();
+    trial.model.budget = Some(crate::mesh::simplify::Budget::Edges(edges));
+    let loaded = load(&trial).ok()?;
+    let mesh = scheme_mesh(&trial, &loaded.raw, loaded.prepared.mesh).ok()?;
+    Some(mesh.mesh)
 }
 
 /// Stage 1, load: reads and prepares the model.
@@ -331,6 +353,7 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
         topology,
         notes,
         warnings,
+        clean_budget: std::cell::OnceCell::new(),
     })
 }
 
@@ -355,7 +378,9 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
     let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default(), flat_fold)
         .map_err(|e| Error::internal("unrolling the panels", e))?;
-    let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out)?;
+    let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out, &|| {
+        prepared.clean_budget(job)
+    })?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
         // is a projection of a warped polygon.
@@ -628,7 +653,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     progress.stage("making the panels");
     let output = scheme(job, &prepared)?;
     crate::internal::name_panels(output.panels.iter().map(|p| p.id().to_string()));
-    let fastening = crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output);
+    let fastening = crate::sanity::check_fasteners(job, &output, &|| prepared.clean_budget(job));
     // Under --strict it is a refusal after the label check (which may refuse first).
     if let (Some(warning), false) = (&fastening, job.strict) {
         warn(warning);

@@ -130,6 +130,7 @@ pub fn check_labels(
     mesh: &Mesh,
     panels: usize,
     left_out: &crate::labels::LeftOut,
+    budget: &dyn Fn() -> Option<usize>,
 ) -> Result<Option<String>> {
     if panels == 0 || (left_out.panel as f64) <= IDS_LEFT_OUT * panels as f64 {
         return Ok(None);
@@ -137,7 +138,7 @@ pub fn check_labels(
     let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
     lengths.sort_by(f64::total_cmp);
     let buildable = smallest_buildable_edge(job, mesh);
-    let warning = too_detailed(job, mesh, &lengths, buildable, panels, left_out);
+    let warning = too_detailed(job, mesh, &lengths, buildable, panels, left_out, budget);
     strict(job, std::slice::from_ref(&warning))?;
     Ok(Some(warning))
 }
@@ -151,20 +152,31 @@ fn too_detailed(
     buildable: Option<f64>,
     panels: usize,
     left_out: &crate::labels::LeftOut,
+    budget: &dyn Fn() -> Option<usize>,
+) -> String {
+    format!(
+        "the model is too detailed for its size: {} of {panels} {} panels have no room for their id and {} partner ids are left out; {}",
+        left_out.panel,
+        job.scheme.name(),
+        left_out.partner,
+        detail_fixes(mesh, lengths, buildable, budget)
+    )
+}
+
+/// The fixes of a model too detailed for its size: the budget that was tried and
+/// builds clean, and the size at which all but the shortest [`SHORT_TAIL`] of its
+/// edges (`lengths`, sorted) reach the `buildable` edge.
+fn detail_fixes(
+    mesh: &Mesh,
+    lengths: &[f64],
+    buildable: Option<f64>,
+    budget: &dyn Fn() -> Option<usize>,
 ) -> String {
     let mut fixes = Vec::new();
+    if let Some(budget) = budget() {
+        fixes.push(format!("--target-edges {budget}"));
+    }
     if let (Some(buildable), false) = (buildable, lengths.is_empty()) {
-        let median = lengths[lengths.len() / 2];
-        let edges = lengths.len() as f64;
-        let triangles = mesh.faces().all(|f| mesh.face_degree(f) == 3);
-        if triangles {
-            // At a fixed surface the edge count goes with the inverse square of the
-            // edge length.
-            let target = round_down_2(edges * (median / (SPREAD_MARGIN * buildable)).powi(2));
-            if target >= 6.0 && target < edges {
-                fixes.push(format!("--target-edges {target:.0}"));
-            }
-        }
         // Or build it larger: the short edges grow with the model.
         let short = lengths[(lengths.len() as f64 * SHORT_TAIL) as usize];
         if short < buildable {
@@ -172,15 +184,11 @@ fn too_detailed(
             fixes.push(format!("--size {}", length_text(size)));
         }
     }
-    let fix = if fixes.is_empty() {
+    if fixes.is_empty() {
         "simplify the model (--target-edges) or build it larger (--size)".to_string()
     } else {
         format!("try {}", fixes.join(" or "))
-    };
-    format!(
-        "the model is too detailed for its size: {} of {panels} {} panels have no room for their id and {} partner ids are left out; {fix}",
-        left_out.panel, job.scheme.name(), left_out.partner
-    )
+    }
 }
 
 /// The smallest edge length (mm) at which the job's scheme, on a regular mesh of the
@@ -241,6 +249,82 @@ fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool)
     Some(hi)
 }
 
+/// The job's model simplified to a number of edges as `--target-edges` would, scaled
+/// and split as the scheme needs (`None` when that fails).
+pub type MeshAt<'a> = dyn Fn(usize) -> Option<Mesh> + 'a;
+
+/// Budgets a warning tries, from its estimate down, before it gives up naming one.
+const BUDGET_TRIALS: usize = 6;
+
+/// Each budget tried is this fraction of the one before.
+const BUDGET_STEP: f64 = 0.8;
+
+/// The budget the warnings suggest, tried: the model simplified to it builds clean
+/// ([`builds_clean`]). The first tried is the fewer of two estimates: where the median
+/// edge is [`SPREAD_MARGIN`] times the smallest edge at which the scheme's panels carry
+/// their labels, and where the faces, of that many times the smallest edge at which
+/// they hold their fastener holes, cover the model's area.
+pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    lengths.sort_by(f64::total_cmp);
+    let median = *lengths.get(lengths.len() / 2)?;
+    let edges = lengths.len();
+    let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
+    // At a fixed surface the edge count goes with the inverse square of the edge
+    // length.
+    let for_labels = smallest_buildable_edge(job, mesh)
+        .map(|edge| edges as f64 * (median / (SPREAD_MARGIN * edge)).powi(2));
+    let for_holes = smallest_fastened_edge(job)
+        .map(|edge| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2)));
+    let estimate = for_labels
+        .into_iter()
+        .chain(for_holes)
+        .fold(f64::INFINITY, f64::min);
+    checked_budget(job, round_down_2(estimate), edges, mesh_at)
+}
+
+/// A budget a warning may suggest because it was tried: from `estimate` down by a
+/// fifth at a time, the first at which the model, simplified as `--target-edges` would
+/// do it (`mesh_at`), builds clean ([`builds_clean`]); where a budget is below the
+/// fewest edges the model's topology allows, up by a quarter until one simplifies.
+/// `None` when a budget is not below the model's `edges`, or none of [`BUDGET_TRIALS`]
+/// budgets builds clean.
+pub fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
+    let mut budget = estimate.floor();
+    let mut below_minimum = false;
+    for _ in 0..BUDGET_TRIALS {
+        if budget < 6.0 || budget >= edges as f64 {
+            return None;
+        }
+        let asked = budget as usize;
+        match mesh_at(asked) {
+            None => {
+                below_minimum = true;
+                budget = (budget / BUDGET_STEP).ceil();
+            }
+            Some(mesh) if builds_clean(job, &mesh) => return Some(asked),
+            // Fewer edges would be below the minimum again.
+            Some(_) if below_minimum => return None,
+            Some(_) => budget = round_down_2(budget * BUDGET_STEP),
+        }
+    }
+    None
+}
+
+/// Whether the job's scheme builds `mesh` with nothing to warn of: every panel holds
+/// its id, and every connection the fastener holes asked for.
+pub fn builds_clean(job: &Job, mesh: &Mesh) -> bool {
+    let Ok(output) = job.scheme.build(mesh) else {
+        return false;
+    };
+    if !output.unfastened.is_empty() {
+        return false;
+    }
+    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+        .is_ok_and(|(_, left_out)| left_out.panel == 0)
+}
+
 /// Connections a warning names before it counts the rest.
 const NAMED: usize = 5;
 
@@ -253,7 +337,11 @@ const AREA_PER_EDGE: f64 = 0.288_675;
 /// (a model too detailed for the fastener) gives one line with the `--target-edges`
 /// at which the faces hold one. [`refuse_unfastened`] makes either a refusal under
 /// `--strict`.
-pub fn check_fasteners(job: &Job, mesh: &Mesh, output: &SchemeOutput) -> Option<String> {
+pub fn check_fasteners(
+    job: &Job,
+    output: &SchemeOutput,
+    budget: &dyn Fn() -> Option<usize>,
+) -> Option<String> {
     let bare = &output.unfastened;
     if bare.is_empty() {
         return None;
@@ -266,12 +354,8 @@ pub fn check_fasteners(job: &Job, mesh: &Mesh, output: &SchemeOutput) -> Option<
     );
     let (n, connections) = (bare.len(), output.connections);
     let warning = if n as f64 > MOST_UNFASTENED * connections as f64 {
-        let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
-        let budget = smallest_fastened_edge(job)
-            .map(|edge| round_down_2(area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2))))
-            .filter(|&b| b >= 6.0 && b < mesh.edge_count() as f64);
-        let fix = match budget {
-            Some(b) => format!("--target-edges {b:.0} makes faces large enough for one"),
+        let fix = match budget() {
+            Some(b) => format!("--target-edges {b} makes faces large enough for one"),
             None => "simplify the model (--target-edges) or build it larger (--size)".into(),
         };
         format!(
