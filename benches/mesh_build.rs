@@ -1,12 +1,16 @@
 //! Reading and building the half-edge mesh: a generated 1M-face quad torus and the
-//! shared models when present. Run with `cargo bench --bench mesh_build`.
+//! shared models when present, and simplifying the bunny. Run with
+//! `cargo bench --bench mesh_build`.
 
 use std::path::{Path, PathBuf};
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::DVec3;
 
-use unfold::mesh::{build_mesh, prepare, read_model, Polygons, PrepareOptions};
+use unfold::mesh::simplify::{
+    decimate_to, simplify, Budget, SimplifyError, SimplifyMode, SimplifyReport,
+};
+use unfold::mesh::{build_mesh, prepare, read_model, Mesh, Polygons, PrepareOptions};
 
 /// An n × m quad torus as polygons (radii 100 and 40).
 fn torus(n: usize, m: usize) -> Polygons {
@@ -86,7 +90,40 @@ fn mesh_build(c: &mut Criterion) {
         });
     }
     group.finish();
+    simplification(c, &shared);
 }
+
+/// The bunny to the thesis' 625 edges in both modes, by the pipeline (meshoptimizer's
+/// result where it keeps the topology) and by the decimator alone; the deviation and
+/// the spread of the edge lengths of each are printed beside the times.
+fn simplification(c: &mut Criterion, shared: &Path) {
+    let raw = read_model(&shared.join("stanford-bunny.obj")).unwrap();
+    let mesh = prepare(&raw, &PrepareOptions::default()).unwrap().mesh;
+    let budget = Budget::Edges(625);
+    let mut group = c.benchmark_group("simplify-bunny-625");
+    group.sample_size(10);
+    for mode in [SimplifyMode::Regular, SimplifyMode::Accurate] {
+        let ways: [(&str, SimplifyFn); 2] = [("pipeline", simplify), ("decimator", decimate_to)];
+        for (way, run) in ways {
+            let (_, r) = run(&mesh, budget, mode).unwrap();
+            eprintln!(
+                "bunny to 625 edges, {mode}, {way}: {} edges, deviation {:.3e} at most, {:.3e} mean (model units), longest edge {:.2} and 95 % within {:.2} times the median{}",
+                r.after.1,
+                r.deviation,
+                r.mean_deviation,
+                r.edge_spread,
+                r.edge_spread_95,
+                r.fallback.map(|f| format!(" ({f})")).unwrap_or_default()
+            );
+            group.bench_function(format!("{mode}/{way}"), |b| {
+                b.iter(|| run(&mesh, budget, mode).unwrap())
+            });
+        }
+    }
+    group.finish();
+}
+
+type SimplifyFn = fn(&Mesh, Budget, SimplifyMode) -> Result<(Mesh, SimplifyReport), SimplifyError>;
 
 criterion_group!(benches, mesh_build);
 criterion_main!(benches);

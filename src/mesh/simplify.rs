@@ -115,6 +115,26 @@ pub fn simplify(
     budget: Budget,
     mode: SimplifyMode,
 ) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+    simplify_with(mesh, budget, mode, true)
+}
+
+/// [`simplify`] with the project's decimator alone, never meshoptimizer: what the
+/// benchmarks compare meshoptimizer's results with.
+pub fn decimate_to(
+    mesh: &Mesh,
+    budget: Budget,
+    mode: SimplifyMode,
+) -> Result<(Mesh, SimplifyReport), SimplifyError> {
+    simplify_with(mesh, budget, mode, false)
+}
+
+/// [`simplify`], trying meshoptimizer first when `meshopt_first`.
+fn simplify_with(
+    mesh: &Mesh,
+    budget: Budget,
+    mode: SimplifyMode,
+    meshopt_first: bool,
+) -> Result<(Mesh, SimplifyReport), SimplifyError> {
     let before = mesh.topology();
     let positions: Vec<f32> = mesh
         .positions()
@@ -206,9 +226,11 @@ pub fn simplify(
         SimplifyMode::Regular => meshopt::SimplifyOptions::Regularize,
         SimplifyMode::Accurate => meshopt::SimplifyOptions::empty(),
     };
-    if let Ok(done) = input.rebuild(&input.simplified_triangles(options)) {
-        if input.reached(&done.1) {
-            return Ok(done);
+    if meshopt_first {
+        if let Ok(done) = input.rebuild(&input.simplified_triangles(options)) {
+            if input.reached(&done.1) {
+                return Ok(done);
+            }
         }
     }
     // meshoptimizer glued the surface to itself, closed a hole, lost a part or stopped
@@ -228,7 +250,9 @@ pub fn simplify(
             components: input.before.components.len(),
         });
     }
-    report.fallback = Some("edge collapses that keep the topology");
+    if meshopt_first {
+        report.fallback = Some("edge collapses that keep the topology");
+    }
     Ok((simplified, report))
 }
 
