@@ -144,30 +144,8 @@ fn simplify_with(
     let bytes: Vec<u8> = positions.iter().flat_map(|x| x.to_le_bytes()).collect();
     let adapter = meshopt::VertexDataAdapter::new(&bytes, 12, 0)
         .map_err(|e| SimplifyError::Invalid(e.to_string()))?;
-    // The simplifier works on triangles: larger faces are split first (the same
-    // triangulation the schemes use for non-planar faces).
-    let mut indices: Vec<u32> = Vec::with_capacity(3 * mesh.face_count());
-    for f in mesh.faces() {
-        let corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
-        if corners.len() == 3 {
-            indices.extend_from_slice(&corners);
-        } else {
-            let points: Vec<glam::DVec3> = mesh.face_positions(f).collect();
-            for t in super::split::triangulate(&points) {
-                indices.extend(t.map(|k| corners[k]));
-            }
-        }
-    }
-
-    // Three evenly spaced vertices of every boundary loop stay put, so no hole can
-    // shrink to nothing; the rest of a border still simplifies along itself.
-    let mut locked = vec![false; mesh.vertex_count()];
-    for start in mesh.boundary_loops() {
-        let ring: Vec<u32> = mesh.loop_from(start).map(|h| mesh.origin(h).0).collect();
-        for k in 0..3 {
-            locked[ring[k * ring.len() / 3] as usize] = true;
-        }
-    }
+    let indices = triangle_indices(mesh);
+    let locked = locked_border_vertices(mesh);
     // Edges of a triangle mesh: 3F = 2E − b, so aim F at (2E − b) / 3 and correct a few
     // times with what the simplifier really produced.
     let boundary = before.boundary_edges;
@@ -178,22 +156,7 @@ fn simplify_with(
         Budget::Edges(e) => (2 * e).saturating_sub(boundary) / 3,
     };
     if target >= triangles {
-        // Already within the budget: nothing to collapse.
-        let spread = edge_spread(mesh);
-        return Ok((
-            mesh.clone(),
-            SimplifyReport {
-                before: (before.faces, before.edges),
-                after: (before.faces, before.edges),
-                deviation: 0.0,
-                mean_deviation: 0.0,
-                relaxed_moves: 0,
-                relaxed_flips: 0,
-                edge_spread: spread.0,
-                edge_spread_95: spread.1,
-                fallback: None,
-            },
-        ));
+        return Ok(unchanged(mesh, &before));
     }
     // The original surface, built once for every attempt: where the deviation is
     // measured, and (regular mode) a grid of its triangles for the relaxation.
@@ -254,6 +217,55 @@ fn simplify_with(
         report.fallback = Some("edge collapses that keep the topology");
     }
     Ok((simplified, report))
+}
+
+/// A mesh already within the budget, as it is: nothing to collapse.
+fn unchanged(mesh: &Mesh, before: &Topology) -> (Mesh, SimplifyReport) {
+    let spread = edge_spread(mesh);
+    let report = SimplifyReport {
+        before: (before.faces, before.edges),
+        after: (before.faces, before.edges),
+        deviation: 0.0,
+        mean_deviation: 0.0,
+        relaxed_moves: 0,
+        relaxed_flips: 0,
+        edge_spread: spread.0,
+        edge_spread_95: spread.1,
+        fallback: None,
+    };
+    (mesh.clone(), report)
+}
+
+/// The mesh's faces as a triangle index list, as the simplifier works on triangles:
+/// larger faces are split (the same triangulation the schemes use for non-planar
+/// faces).
+fn triangle_indices(mesh: &Mesh) -> Vec<u32> {
+    let mut indices: Vec<u32> = Vec::with_capacity(3 * mesh.face_count());
+    for f in mesh.faces() {
+        let corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+        if corners.len() == 3 {
+            indices.extend_from_slice(&corners);
+        } else {
+            let points: Vec<glam::DVec3> = mesh.face_positions(f).collect();
+            for t in super::split::triangulate(&points) {
+                indices.extend(t.map(|k| corners[k]));
+            }
+        }
+    }
+    indices
+}
+
+/// Three evenly spaced vertices of every boundary loop, which stay put so no hole can
+/// shrink to nothing; the rest of a border still simplifies along itself.
+fn locked_border_vertices(mesh: &Mesh) -> Vec<bool> {
+    let mut locked = vec![false; mesh.vertex_count()];
+    for start in mesh.boundary_loops() {
+        let ring: Vec<u32> = mesh.loop_from(start).map(|h| mesh.origin(h).0).collect();
+        for k in 0..3 {
+            locked[ring[k * ring.len() / 3] as usize] = true;
+        }
+    }
+    locked
 }
 
 /// The triangles to simplify and what to aim for.
