@@ -64,7 +64,51 @@ pub fn facet_frames<'a>(panel: impl Into<PanelRef<'a>>) -> Result<Vec<FacetFrame
 /// less are not scored.
 fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
     let fail_id = || panel.id().to_string();
-    let normals: Vec<DVec3> = panel
+    let normals = facet_normals(panel)?;
+    let edges = edge_uses(panel);
+    let (hinges, folds) = hinges_and_folds(panel, &normals, &edges, flat_fold)?;
+    let (points, frames) = lay_out_facets(panel, &normals, &hinges)?;
+
+    let mut developability_error = 0.0f64;
+    let mut area = 0.0;
+    for facet in &panel.facets {
+        area += loop_signed_area(&points, facet);
+        for k in 0..facet.len() {
+            let (i, j) = (facet[k] as usize, facet[(k + 1) % facet.len()] as usize);
+            let d3 = panel.vertices[i].distance(panel.vertices[j]);
+            let d2 = points[i].distance(points[j]);
+            developability_error = developability_error.max((d3 - d2).abs());
+        }
+    }
+
+    let outline = outline_loops(&edges, &points)
+        .ok_or_else(|| FlattenError::OpenOutline { panel: fail_id() })?;
+    let holes = panel
+        .holes
+        .iter()
+        .map(|h| FlatHole {
+            center: frames[h.facet as usize].to_2d(h.position),
+            diameter: h.diameter,
+            connection: h.connection,
+            facet: h.facet,
+        })
+        .collect();
+    let flat = FlatPanel {
+        source: panel.source,
+        points,
+        outline: outline.into_iter().collect(),
+        folds,
+        holes,
+        labels: Vec::new(),
+        developability_error,
+        area,
+    };
+    Ok((flat, frames))
+}
+
+/// The unit normal of every facet of `panel`; a facet without area is an error.
+fn facet_normals(panel: PanelRef) -> Result<Vec<DVec3>, FlattenError> {
+    panel
         .facets
         .iter()
         .enumerate()
@@ -74,15 +118,17 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
                 Ok(n.normalize())
             } else {
                 Err(FlattenError::DegenerateFacet {
-                    panel: fail_id(),
+                    panel: panel.id().to_string(),
                     facet: k as u32,
                 })
             }
         })
-        .collect::<Result<_, _>>()?;
+        .collect()
+}
 
-    // Every facet edge once per use, grouped by its two vertices (smaller first); the
-    // stable sort keeps the uses of an edge in facet order.
+/// Every facet edge of `panel` once per use, grouped by its two vertices (smaller
+/// first); the stable sort keeps the uses of an edge in facet order.
+fn edge_uses(panel: PanelRef) -> Vec<EdgeUse> {
     let mut edges: Vec<EdgeUse> = Vec::with_capacity(panel.facets.index_count());
     for (k, facet) in panel.facets.iter().enumerate() {
         for i in 0..facet.len() {
@@ -96,8 +142,22 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
         }
     }
     edges.sort_by_key(|e| e.key);
-    // Hinges as (facet, other facet, a, b), both ways, in edge order per facet.
-    let mut hinges: Vec<(u32, u32, u32, u32)> = Vec::new();
+    edges
+}
+
+/// A hinge: (facet, other facet, a, b), where the two facets share the edge ab.
+type Hinge = (u32, u32, u32, u32);
+
+/// The hinges between facets, both ways, sorted by their first facet (in edge order
+/// per facet), and the folds: the hinges that bend by more than `flat_fold`. An edge
+/// used by three or more facets is an error.
+fn hinges_and_folds(
+    panel: PanelRef,
+    normals: &[DVec3],
+    edges: &[EdgeUse],
+    flat_fold: f64,
+) -> Result<(Vec<Hinge>, Vec<Fold>), FlattenError> {
+    let mut hinges: Vec<Hinge> = Vec::new();
     let mut folds = Vec::new();
     for users in edges.chunk_by(|x, y| x.key == y.key) {
         let (a, b) = users[0].key;
@@ -118,7 +178,7 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
             }
             _ => {
                 return Err(FlattenError::NonManifold {
-                    panel: fail_id(),
+                    panel: panel.id().to_string(),
                     a,
                     b,
                 })
@@ -126,12 +186,22 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
         }
     }
     hinges.sort_by_key(|h| h.0);
+    Ok((hinges, folds))
+}
+
+/// Every vertex of `panel` laid flat and every facet's frame: the first facet on the
+/// x axis, then each facet turned about a hinge onto the one it joins, breadth first.
+/// A facet no hinge reaches is an error.
+fn lay_out_facets(
+    panel: PanelRef,
+    normals: &[DVec3],
+    hinges: &[Hinge],
+) -> Result<(Vec<DVec2>, Vec<FacetFrame>), FlattenError> {
     let hinges_of = |f: usize| {
         let start = hinges.partition_point(|h| (h.0 as usize) < f);
         let end = hinges.partition_point(|h| (h.0 as usize) <= f);
         &hinges[start..end]
     };
-
     let mut points = vec![DVec2::NAN; panel.vertices.len()];
     let mut frames: Vec<Option<FacetFrame>> = vec![None; panel.facets.len()];
     let mut queue = VecDeque::new();
@@ -171,46 +241,14 @@ fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>
             queue.push_back(g);
         }
     }
-    let frames: Vec<FacetFrame> = frames
-        .into_iter()
-        .collect::<Option<_>>()
-        .ok_or_else(|| FlattenError::Disconnected { panel: fail_id() })?;
-
-    let mut developability_error = 0.0f64;
-    let mut area = 0.0;
-    for facet in &panel.facets {
-        area += loop_signed_area(&points, facet);
-        for k in 0..facet.len() {
-            let (i, j) = (facet[k] as usize, facet[(k + 1) % facet.len()] as usize);
-            let d3 = panel.vertices[i].distance(panel.vertices[j]);
-            let d2 = points[i].distance(points[j]);
-            developability_error = developability_error.max((d3 - d2).abs());
-        }
-    }
-
-    let outline = outline_loops(&edges, &points)
-        .ok_or_else(|| FlattenError::OpenOutline { panel: fail_id() })?;
-    let holes = panel
-        .holes
-        .iter()
-        .map(|h| FlatHole {
-            center: frames[h.facet as usize].to_2d(h.position),
-            diameter: h.diameter,
-            connection: h.connection,
-            facet: h.facet,
-        })
-        .collect();
-    let flat = FlatPanel {
-        source: panel.source,
-        points,
-        outline: outline.into_iter().collect(),
-        folds,
-        holes,
-        labels: Vec::new(),
-        developability_error,
-        area,
-    };
-    Ok((flat, frames))
+    let frames: Vec<FacetFrame> =
+        frames
+            .into_iter()
+            .collect::<Option<_>>()
+            .ok_or_else(|| FlattenError::Disconnected {
+                panel: panel.id().to_string(),
+            })?;
+    Ok((points, frames))
 }
 
 /// Unrolls a panel and fits its labels: the flatten stage for one panel. Returns how

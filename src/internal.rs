@@ -77,12 +77,7 @@ fn inject_panic(index: usize) {
 pub fn install_hook() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
-        let payload = info.payload();
-        let text = payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "a panic".to_string());
+        let text = payload_text(info.payload());
         let message = match info.location() {
             Some(at) => format!("{text} (at {}:{})", at.file(), at.line()),
             None => text,
@@ -108,16 +103,9 @@ pub fn catch<R>(work: impl FnOnce() -> Result<R>) -> Result<R> {
         Ok(result) => result,
         Err(payload) => {
             let caught = lock(&CAUGHT).take();
-            let message = caught.as_ref().map_or_else(
-                || {
-                    payload
-                        .downcast_ref::<&str>()
-                        .map(|s| s.to_string())
-                        .or_else(|| payload.downcast_ref::<String>().cloned())
-                        .unwrap_or_else(|| "a panic".to_string())
-                },
-                |c| c.message.clone(),
-            );
+            let message = caught
+                .as_ref()
+                .map_or_else(|| payload_text(payload.as_ref()), |c| c.message.clone());
             let panel = caught
                 .and_then(|c| c.panel)
                 .map(|i| lock(&PANEL_IDS).get(i).cloned().unwrap_or(format!("#{i}")));
@@ -133,6 +121,15 @@ pub fn catch<R>(work: impl FnOnce() -> Result<R>) -> Result<R> {
             })
         }
     }
+}
+
+/// What a panic said: its message when it is text.
+fn payload_text(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".to_string())
 }
 
 /// The guarded value, also after a panic elsewhere poisoned the lock.

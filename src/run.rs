@@ -501,63 +501,15 @@ pub fn export(
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "model".into());
     let digits = layout.sheets.to_string().len().max(2);
-    let sheet = layout.sheet;
     // Sheets are independent: drawn in parallel, collected in sheet order.
     let drawn: Vec<DrawnSheet> = (0..layout.sheets)
         .into_par_iter()
         .map(|index| {
             let stem = format!("{name}-{:0digits$}", index + 1);
-            let sheet_files: Vec<(String, Vec<u8>)> = job
-                .formats
-                .iter()
-                .map(|format| {
-                    (
-                        format!("{stem}.{}", format.extension()),
-                        format.write_sheet(layout, index, panels, &job.style),
-                    )
-                })
-                .collect();
-            let mut lengths = Lengths::default();
-            draw_sheet(
-                layout,
-                index,
-                panels,
-                false,
-                PathOrder::Shortest,
-                &mut lengths,
-            );
-            let mut as_placed = Lengths::default();
-            draw_sheet(
-                layout,
-                index,
-                panels,
-                false,
-                PathOrder::AsPlaced,
-                &mut as_placed,
-            );
-            let on_sheet: Vec<FlatPanelRef> = layout
-                .placements
-                .iter()
-                .filter(|p| p.sheet == index)
-                .map(|p| panels.get(p.part))
-                .collect();
-            let area: f64 = on_sheet.iter().map(|p| p.area).sum();
-            let entry = manifest::SheetEntry {
-                sheet: index + 1,
-                files: sheet_files.iter().map(|(n, _)| n.clone()).collect(),
-                panels: on_sheet.len(),
-                fill: round4(area / (sheet.width * sheet.height)),
-                lengths: manifest::Lengths::of(&lengths),
-                time_s: round4(job.speeds.seconds(&lengths)),
-            };
+            let sheet = draw_one_sheet(job, layout, panels, index, &stem);
             let count = drawn_sheets.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
             done(count as f64 / layout.sheets as f64);
-            DrawnSheet {
-                files: sheet_files,
-                lengths,
-                travel_as_placed: as_placed.travel,
-                entry,
-            }
+            sheet
         })
         .collect();
     let mut files: Vec<(String, Vec<u8>)> = Vec::new();
@@ -618,6 +570,68 @@ pub fn export(
         .map_err(|e| Error::internal("writing the manifest", e))?;
     files.push((MANIFEST.into(), (json + "\n").into_bytes()));
     Ok(Exported { files, manifest })
+}
+
+/// Sheet `index` of `layout` in every format of the job, its files named `stem`.ext,
+/// with its path lengths (nearest first, and as placed for the travel) and its
+/// manifest entry.
+fn draw_one_sheet(
+    job: &Job,
+    layout: &Layout,
+    panels: &FlatPanels,
+    index: usize,
+    stem: &str,
+) -> DrawnSheet {
+    let sheet = layout.sheet;
+    let sheet_files: Vec<(String, Vec<u8>)> = job
+        .formats
+        .iter()
+        .map(|format| {
+            (
+                format!("{stem}.{}", format.extension()),
+                format.write_sheet(layout, index, panels, &job.style),
+            )
+        })
+        .collect();
+    let mut lengths = Lengths::default();
+    draw_sheet(
+        layout,
+        index,
+        panels,
+        false,
+        PathOrder::Shortest,
+        &mut lengths,
+    );
+    let mut as_placed = Lengths::default();
+    draw_sheet(
+        layout,
+        index,
+        panels,
+        false,
+        PathOrder::AsPlaced,
+        &mut as_placed,
+    );
+    let on_sheet: Vec<FlatPanelRef> = layout
+        .placements
+        .iter()
+        .filter(|p| p.sheet == index)
+        .map(|p| panels.get(p.part))
+        .collect();
+    let area: f64 = on_sheet.iter().map(|p| p.area).sum();
+    let entry = manifest::SheetEntry {
+        sheet: index + 1,
+        files: sheet_files.iter().map(|(n, _)| n.clone()).collect(),
+        panels: on_sheet.len(),
+        fill: round4(area / (sheet.width * sheet.height)),
+        lengths: manifest::Lengths::of(&lengths),
+        time_s: round4(job.speeds.seconds(&lengths)),
+    };
+    DrawnSheet {
+        files: sheet_files,
+        lengths,
+        travel_as_placed: as_placed.travel,
+        entry,
+    }
 }
 
 /// Runs a job and writes its output folder (replaced whole by a swap, so on any error

@@ -200,11 +200,15 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let mut degrees: Vec<usize> = mesh.faces().map(|f| mesh.face_degree(f)).collect();
     degrees.sort_unstable();
     let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
-    smallest_edge(job, typical, |output| {
-        let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
-        crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
-            .is_ok_and(|(_, left_out)| left_out.panel == 0 && left_out.partner == 0)
-    })
+    smallest_edge(job, typical, |output| labels_fit(output, true))
+}
+
+/// Whether every panel of `output`, unrolled, holds its id (and, with `partners`,
+/// every partner id).
+fn labels_fit(output: &SchemeOutput, partners: bool) -> bool {
+    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+        .is_ok_and(|(_, left_out)| left_out.panel == 0 && (!partners || left_out.partner == 0))
 }
 
 /// The smallest edge length (mm) at which the job's scheme, on a regular mesh of
@@ -289,7 +293,7 @@ pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
 /// fewest edges the model's topology allows, up by a quarter until one simplifies.
 /// `None` when a budget is not below the model's `edges`, or none of [`BUDGET_TRIALS`]
 /// budgets builds clean.
-pub fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
+fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
     let mut budget = estimate.floor();
     let mut below_minimum = false;
     for _ in 0..BUDGET_TRIALS {
@@ -313,16 +317,10 @@ pub fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) 
 
 /// Whether the job's scheme builds `mesh` with nothing to warn of: every panel holds
 /// its id, and every connection the fastener holes asked for.
-pub fn builds_clean(job: &Job, mesh: &Mesh) -> bool {
-    let Ok(output) = job.scheme.build(mesh) else {
-        return false;
-    };
-    if !output.unfastened.is_empty() {
-        return false;
-    }
-    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
-    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
-        .is_ok_and(|(_, left_out)| left_out.panel == 0)
+fn builds_clean(job: &Job, mesh: &Mesh) -> bool {
+    job.scheme
+        .build(mesh)
+        .is_ok_and(|output| output.unfastened.is_empty() && labels_fit(&output, false))
 }
 
 /// Connections a warning names before it counts the rest.

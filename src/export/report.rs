@@ -32,6 +32,48 @@ fn duration(seconds: f64) -> String {
     }
 }
 
+/// The report's lines on the laser: path lengths and folds, the kerf, the time.
+fn laser_lines(s: &mut String, m: &Manifest) {
+    use std::fmt::Write;
+    let _ = writeln!(
+        s,
+        "laser paths: cut {}, score {}, valley score {}, engrave {}; {} mountain and {} valley folds",
+        fmt_path_length(m.lengths.cut),
+        fmt_path_length(m.lengths.score),
+        fmt_path_length(m.lengths.score_valley),
+        fmt_path_length(m.lengths.engrave),
+        m.counts.folds_mountain,
+        m.counts.folds_valley
+    );
+    if m.sheet.kerf > 0.0 {
+        let _ = writeln!(
+            s,
+            "kerf {} mm: every cut loop is offset {} mm into the waste (outlines out, holes and inner cuts in); the parts come out at their nominal size",
+            fmt_num(m.sheet.kerf),
+            fmt_num(m.sheet.kerf / 2.0)
+        );
+    }
+    let times: Vec<f64> = m.sheets.iter().map(|s| s.time_s).collect();
+    let (fastest, slowest) = (
+        times.iter().copied().fold(f64::INFINITY, f64::min),
+        times.iter().copied().fold(0.0, f64::max),
+    );
+    let v = &m.laser.speeds;
+    let _ = writeln!(
+        s,
+        "laser time: about {} at cut {}, score {}, engrave {}, travel {} mm/s ({} to {} a sheet); nearest-first order: travel {} instead of {}",
+        duration(m.laser.time_s),
+        fmt_num(v.cut),
+        fmt_num(v.score),
+        fmt_num(v.engrave),
+        fmt_num(v.travel),
+        duration(fastest),
+        duration(slowest),
+        fmt_path_length(m.lengths.travel),
+        fmt_path_length(m.laser.travel_as_placed)
+    );
+}
+
 /// The short report of a run: its manifest in plain words, then `extras`.
 pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
     use std::fmt::Write;
@@ -82,43 +124,7 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         fills.join(" "),
         crate::units::count_of(m.nesting.shelf_sheets, "sheet")
     );
-    let _ = writeln!(
-        s,
-        "laser paths: cut {}, score {}, valley score {}, engrave {}; {} mountain and {} valley folds",
-        fmt_path_length(m.lengths.cut),
-        fmt_path_length(m.lengths.score),
-        fmt_path_length(m.lengths.score_valley),
-        fmt_path_length(m.lengths.engrave),
-        m.counts.folds_mountain,
-        m.counts.folds_valley
-    );
-    if m.sheet.kerf > 0.0 {
-        let _ = writeln!(
-            s,
-            "kerf {} mm: every cut loop is offset {} mm into the waste (outlines out, holes and inner cuts in); the parts come out at their nominal size",
-            fmt_num(m.sheet.kerf),
-            fmt_num(m.sheet.kerf / 2.0)
-        );
-    }
-    let times: Vec<f64> = m.sheets.iter().map(|s| s.time_s).collect();
-    let (fastest, slowest) = (
-        times.iter().copied().fold(f64::INFINITY, f64::min),
-        times.iter().copied().fold(0.0, f64::max),
-    );
-    let v = &m.laser.speeds;
-    let _ = writeln!(
-        s,
-        "laser time: about {} at cut {}, score {}, engrave {}, travel {} mm/s ({} to {} a sheet); nearest-first order: travel {} instead of {}",
-        duration(m.laser.time_s),
-        fmt_num(v.cut),
-        fmt_num(v.score),
-        fmt_num(v.engrave),
-        fmt_num(v.travel),
-        duration(fastest),
-        duration(slowest),
-        fmt_path_length(m.lengths.travel),
-        fmt_path_length(m.laser.travel_as_placed)
-    );
+    laser_lines(&mut s, m);
     // Exact panels carry only float noise, rounded away in the manifest.
     let error = m.max_developability_error;
     if error == 0.0 {
