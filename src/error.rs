@@ -99,6 +99,15 @@ pub enum Error {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// A model too detailed for its size, stopped before the long stages (exit code
+    /// 2): most of its panels could not carry their ids or fastener holes.
+    #[error("{message}")]
+    TooDetailed {
+        /// The sentence naming what would go wrong and the fixes.
+        message: String,
+        /// The `--target-edges` budget that was tried and builds clean, if one was found.
+        budget: Option<usize>,
+    },
     /// A panic: a bug of unfold, caught and reported on one line (exit code 1).
     #[error("internal error while {stage}{}: {message}; this is a bug in unfold: please report it with the model file and the command line", panel.as_ref().map(|id| format!(" (panel {id})")).unwrap_or_default())]
     Panic {
@@ -127,7 +136,7 @@ impl Error {
     pub fn exit_code(&self) -> i32 {
         match self {
             Error::Build(_) | Error::Io { .. } | Error::Internal { .. } | Error::Panic { .. } => 1,
-            Error::Usage(_) => 2,
+            Error::Usage(_) | Error::TooDetailed { .. } => 2,
             Error::Input(_) => 3,
         }
     }

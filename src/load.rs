@@ -50,6 +50,8 @@ pub fn load_model(
                 settings.simplify_mode
             ),
         };
+        // Deviations in millimetres of the built model, as the build scales it.
+        let mm_per_unit = settings.scaling.mm_per_unit(simplified.longest_side());
         let message = if report.before == report.after {
             format!(
                 "{} faces and {} edges are already within the budget; not simplified",
@@ -57,7 +59,7 @@ pub fn load_model(
             )
         } else {
             format!(
-                "simplified from {} faces and {} edges to {} faces and {} edges ({}; longest edge {:.1} times the median, 95 % within {:.2}){}; deviation from the original surface {:.3e} model units at most, {:.3e} on average (measured at every original vertex and triangle centre)",
+                "simplified from {} faces and {} edges to {} faces and {} edges ({}; longest edge {:.1} times the median, 95 % within {:.2}){}; deviation from the original surface {} mm at most, {} mm on average when built (measured at every original vertex and triangle centre)",
                 report.before.0, report.before.1, report.after.0, report.after.1, mode,
                 report.edge_spread, report.edge_spread_95,
                 if report.relaxed_moves + report.relaxed_flips > 0 {
@@ -65,7 +67,8 @@ pub fn load_model(
                 } else {
                     String::new()
                 },
-                report.deviation, report.mean_deviation
+                crate::units::short_number(report.deviation * mm_per_unit),
+                crate::units::short_number(report.mean_deviation * mm_per_unit)
             )
         };
         prepared.notes.push(Note {

@@ -296,6 +296,7 @@ pub struct Nested {
 fn model_at(job: &Job, edges: usize) -> Option<crate::mesh::Mesh> {
     let mut trial = job.clone();
     trial.model.budget = Some(crate::mesh::simplify::Budget::Edges(edges));
+    trial.model.auto_budget = false;
     let loaded = load(&trial).ok()?;
     let mesh = scheme_mesh(&trial, &loaded.raw, loaded.prepared.mesh).ok()?;
     Some(mesh.mesh)
@@ -644,6 +645,46 @@ pub fn run(job: &Job) -> Result<Outcome> {
 /// [`run`], handing each warning about the build to `warn` as soon as it is known
 /// (before the long stages), so a user can stop a build that is not what they meant.
 pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
+    if !job.model.auto_budget {
+        return build(job, warn);
+    }
+    // `--target-edges auto`: a model too detailed for its size stops with the budget
+    // that was tried and builds clean; it is built again at that budget.
+    let mut said = Vec::new();
+    let mut warn_once = |w: &str| {
+        if !said.iter().any(|s| s == w) {
+            said.push(w.to_string());
+            warn(w);
+        }
+    };
+    match build(job, &mut warn_once) {
+        Err(Error::TooDetailed {
+            budget: Some(budget),
+            ..
+        }) => {
+            let mut chosen = job.clone();
+            chosen.model.auto_budget = false;
+            chosen.model.budget = Some(crate::mesh::simplify::Budget::Edges(budget));
+            let mut outcome = build(&chosen, &mut warn_once)?;
+            outcome.notes.insert(
+                0,
+                format!("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to {budget} edges, the budget at which every panel was tried and holds its id and fastener holes"),
+            );
+            Ok(outcome)
+        }
+        Ok(mut outcome) => {
+            outcome.notes.insert(
+                0,
+                "--target-edges auto: the model builds as it is at this size, so it was not simplified".to_string(),
+            );
+            Ok(outcome)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Builds the sheets of `job` ([`run_observed`] without `--target-edges auto`).
+fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     let mut clock = Stopwatch::new();
     let progress = Progress::new(job);
     let mut warn = |w: &str| progress.suspend(|| warn(w));
@@ -664,10 +705,13 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         warn(warning);
     }
     clock.lap("split");
+    let budget = || prepared.clean_budget(job);
+    crate::sanity::check_detail(job, &prepared.scheme_mesh.mesh, &budget)?;
     progress.stage("making the panels");
     let output = scheme(job, &prepared)?;
     crate::internal::name_panels(output.panels.iter().map(|p| p.id().to_string()));
-    let fastening = crate::sanity::check_fasteners(job, &output, &|| prepared.clean_budget(job));
+    let fastening =
+        crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output, &budget)?;
     // Under --strict it is a refusal after the label check (which may refuse first).
     if let (Some(warning), false) = (&fastening, job.strict) {
         warn(warning);

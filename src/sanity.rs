@@ -34,11 +34,10 @@ const FEW_SHEETS: f64 = 20.0;
 /// left out: a builder cannot place a panel without its id.
 const IDS_LEFT_OUT: f64 = 0.01;
 
-/// A suggested budget aims the median edge this many times the smallest edge at which
-/// the scheme's panels on a regular mesh carry their labels: a simplified scan keeps a
-/// tenth of its edges below two thirds of the median, and those must still carry their
-/// ids (on spot at 3 ft the budgets this gives carry every panel id, half-edge and
-/// quad-edge: tests/size_checks.rs).
+/// A suggested budget is first tried with triangles this many times the smallest at
+/// which the scheme's panels on a regular mesh carry their ids: a simplified scan
+/// keeps a tenth of its edges below two thirds of the median, and those must still
+/// carry their ids (the budget is then tried, and lowered until it builds clean).
 const SPREAD_MARGIN: f64 = 2.25;
 
 /// The fraction of the shortest edges a suggested `--size` lets fall below the
@@ -93,6 +92,12 @@ pub fn check_size(job: &Job, mesh: &Mesh) -> Result<SizeCheck> {
             units_hint()
         ));
     }
+    if let Some(thickness) = flat_within(mesh) {
+        warnings.push(format!(
+            "{model} is flat: every vertex lies within {} mm of one plane, so its panels lie flat beside each other and meet at folds of almost nothing; build a solid model (a closed surface), or cut the flat shape directly",
+            short(thickness)
+        ));
+    }
     let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
     let sheets = area / (usable_w * usable_h);
     if sheets > LARGE_SHEETS {
@@ -113,6 +118,22 @@ pub fn check_size(job: &Job, mesh: &Mesh) -> Result<SizeCheck> {
     Ok(SizeCheck { warnings })
 }
 
+/// A model whose vertices all lie within this fraction of its longest side of one
+/// plane is flat: a scan of a relief, or a drawing exported as a mesh.
+const FLAT_FRACTION: f64 = 0.01;
+
+/// The largest distance (mm) of a vertex of `mesh` from its best-fit plane, when the
+/// model is flat ([`FLAT_FRACTION`]).
+fn flat_within(mesh: &Mesh) -> Option<f64> {
+    let points = mesh.positions();
+    let (centre, normal) = crate::mesh::geometry::best_fit_plane(points);
+    let thickness = points
+        .iter()
+        .map(|&p| (p - centre).dot(normal).abs())
+        .fold(0.0, f64::max);
+    (thickness <= FLAT_FRACTION * mesh.longest_side()).then_some(thickness)
+}
+
 /// With `--strict`, the first warning as a refusal.
 fn strict(job: &Job, warnings: &[String]) -> Result<()> {
     match warnings.first() {
@@ -123,8 +144,8 @@ fn strict(job: &Job, warnings: &[String]) -> Result<()> {
 
 /// Checks, after the labels were fitted and before the nest, that the panels carry
 /// their ids: more than `IDS_LEFT_OUT` of them left out means the model is too
-/// detailed for its size. The warning gives the budget (and the size) at which the
-/// scheme's panels carry them. With `--strict` it is a refusal.
+/// detailed for its size, and the build stops ([`too_detailed`]) naming the budget
+/// (and the size) at which the scheme's panels carry them.
 pub fn check_labels(
     job: &Job,
     mesh: &Mesh,
@@ -135,48 +156,86 @@ pub fn check_labels(
     if panels == 0 || (left_out.panel as f64) <= IDS_LEFT_OUT * panels as f64 {
         return Ok(None);
     }
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_by(f64::total_cmp);
-    let buildable = smallest_buildable_edge(job, mesh);
-    let warning = too_detailed(job, mesh, &lengths, buildable, panels, left_out, budget);
-    strict(job, std::slice::from_ref(&warning))?;
-    Ok(Some(warning))
+    let what = format!(
+        "{} of {panels} {} panels have no room for their id and {} partner ids are left out",
+        left_out.panel,
+        job.scheme.name(),
+        left_out.partner
+    );
+    let most = 2 * left_out.panel > panels;
+    too_detailed(job, mesh, &what, most, budget).map(Some)
 }
 
-/// The warning for panels too small for their labels, with the budget (and the size)
-/// that makes them carry their ids.
+/// Stops, before the scheme makes a panel, a model whose median edge is shorter than
+/// the smallest at which the scheme's panels hold their ids on an even mesh: most of
+/// them would have none, and the long stages would take minutes to make them
+/// ([`too_detailed`]). A build with `--build-anyway` goes on; the later checks warn.
+pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<usize>) -> Result<()> {
+    if job.build_anyway {
+        return Ok(());
+    }
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    lengths.sort_by(f64::total_cmp);
+    let Some(&median) = lengths.get(lengths.len() / 2) else {
+        return Ok(());
+    };
+    let Some(buildable) = smallest_buildable_edge(job, mesh).filter(|&b| median < b) else {
+        return Ok(());
+    };
+    let what = format!(
+        "its median edge would be {} mm, shorter than the {} mm at which {} panels hold their ids",
+        short(median),
+        short(buildable),
+        job.scheme.name()
+    );
+    too_detailed(job, mesh, &what, true, budget).map(|_| ())
+}
+
+/// What a model too detailed for its size gets: a stop before the long stages (exit
+/// 2, nothing written) naming the budget that was tried and builds clean, the size at
+/// which the model's own edges carry the labels, `--target-edges auto` and
+/// `--build-anyway`. A build with `--build-anyway`, or with a `--target-edges` the
+/// user chose where not `most` panels or connections go without, gets the same as a
+/// warning (a refusal under `--strict`).
 fn too_detailed(
     job: &Job,
     mesh: &Mesh,
-    lengths: &[f64],
-    buildable: Option<f64>,
-    panels: usize,
-    left_out: &crate::labels::LeftOut,
+    what: &str,
+    most: bool,
     budget: &dyn Fn() -> Option<usize>,
-) -> String {
-    format!(
-        "the model is too detailed for its size: {} of {panels} {} panels have no room for their id and {} partner ids are left out; {}",
-        left_out.panel,
-        job.scheme.name(),
-        left_out.partner,
-        detail_fixes(mesh, lengths, buildable, budget)
-    )
+) -> Result<String> {
+    let budget = budget();
+    let fixes = detail_fixes(job, mesh, budget);
+    if job.build_anyway || (job.model.budget.is_some() && !most) {
+        let warning = format!("the model is too detailed for its size: {what}; {fixes}");
+        strict(job, std::slice::from_ref(&warning))?;
+        return Ok(warning);
+    }
+    let auto = if budget.is_some() {
+        " (or --target-edges auto)"
+    } else {
+        ""
+    };
+    Err(Error::TooDetailed {
+        message: format!(
+            "{} is too detailed for its size: {what}; stopped before laying out the sheets (nothing written): {fixes}{auto}; --build-anyway builds it as it is",
+            job.model_path.display()
+        ),
+        budget,
+    })
 }
 
-/// The fixes of a model too detailed for its size: the budget that was tried and
+/// The fixes of a model too detailed for its size: the `budget` that was tried and
 /// builds clean, and the size at which all but the shortest [`SHORT_TAIL`] of its
-/// edges (`lengths`, sorted) reach the `buildable` edge.
-fn detail_fixes(
-    mesh: &Mesh,
-    lengths: &[f64],
-    buildable: Option<f64>,
-    budget: &dyn Fn() -> Option<usize>,
-) -> String {
+/// edges reach the smallest edge at which the scheme's panels carry their labels.
+fn detail_fixes(job: &Job, mesh: &Mesh, budget: Option<usize>) -> String {
     let mut fixes = Vec::new();
-    if let Some(budget) = budget() {
+    if let Some(budget) = budget {
         fixes.push(format!("--target-edges {budget}"));
     }
-    if let (Some(buildable), false) = (buildable, lengths.is_empty()) {
+    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    lengths.sort_by(f64::total_cmp);
+    if let (Some(buildable), false) = (smallest_buildable_edge(job, mesh), lengths.is_empty()) {
         // Or build it larger: the short edges grow with the model.
         let short = lengths[(lengths.len() as f64 * SHORT_TAIL) as usize];
         if short < buildable {
@@ -192,23 +251,22 @@ fn detail_fixes(
 }
 
 /// The smallest edge length (mm) at which the job's scheme, on a regular mesh of the
-/// job's kind of faces, gives every panel its id and every connection its partner ids;
-/// found by building that mesh at trial sizes with the job's own options. `None` when
-/// no trial size up to 2 m fits them. Holes are not asked for: where flaps are too
-/// small for them the fasteners check reports the connections without.
+/// job's kind of faces, gives every panel its id (what the label check asks; partner
+/// ids on short flaps may still be left out); found by building that mesh at trial
+/// sizes with the job's own options. `None` when no trial size up to 2 m fits them.
+/// Holes are not asked for: the fasteners check reports the connections without.
 pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let mut degrees: Vec<usize> = mesh.faces().map(|f| mesh.face_degree(f)).collect();
     degrees.sort_unstable();
     let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
-    smallest_edge(job, typical, |output| labels_fit(output, true))
+    smallest_edge(job, typical, ids_fit)
 }
 
-/// Whether every panel of `output`, unrolled, holds its id (and, with `partners`,
-/// every partner id).
-fn labels_fit(output: &SchemeOutput, partners: bool) -> bool {
+/// Whether every panel of `output`, unrolled, holds its id.
+fn ids_fit(output: &SchemeOutput) -> bool {
     let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
     crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
-        .is_ok_and(|(_, left_out)| left_out.panel == 0 && (!partners || left_out.partner == 0))
+        .is_ok_and(|(_, left_out)| left_out.panel == 0)
 }
 
 /// The smallest edge length (mm) at which the job's scheme, on a regular mesh of
@@ -220,7 +278,9 @@ pub fn smallest_fastened_edge(job: &Job) -> Option<f64> {
 
 /// The smallest edge length (mm), between 0.5 mm and 2 m to 2 %, at which the job's
 /// scheme built on a regular probe mesh of `degree`-sided faces makes an output that
-/// `fits` (searched on a log scale: larger faces fit what smaller ones do).
+/// `fits` (searched on a log scale: larger faces fit what smaller ones do, up to the
+/// size where a panel no longer fits the sheet, so the search starts from the largest
+/// size, halved, that fits).
 fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool) -> Option<f64> {
     let text: &[u8] = match degree {
         3 => include_bytes!("../models/icosahedron.obj"),
@@ -235,12 +295,20 @@ fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool)
         scaled.scale(length / edge);
         job.scheme.build(&scaled).is_ok_and(|output| fits(&output))
     };
-    let (mut lo, mut hi) = (0.5f64, 2000.0f64);
-    if !fits_at(hi) {
-        return None;
+    let mut hi = PROBE_LARGEST;
+    while !fits_at(hi) {
+        hi /= 2.0;
+        if hi < PROBE_SMALLEST {
+            return None;
+        }
     }
-    if fits_at(lo) {
-        return Some(lo);
+    let mut lo = hi / 2.0;
+    while fits_at(lo) {
+        hi = lo;
+        lo /= 2.0;
+        if lo < PROBE_SMALLEST {
+            return Some(hi);
+        }
     }
     while hi / lo > 1.02 {
         let mid = (lo * hi).sqrt();
@@ -253,48 +321,52 @@ fn smallest_edge(job: &Job, degree: usize, fits: impl Fn(&SchemeOutput) -> bool)
     Some(hi)
 }
 
+/// The largest probe edge (mm) tried.
+const PROBE_LARGEST: f64 = 2000.0;
+
+/// The smallest probe edge (mm) tried: a panel of smaller edges is below any laser's
+/// detail.
+const PROBE_SMALLEST: f64 = 0.5;
+
 /// The job's model simplified to a number of edges as `--target-edges` would, scaled
 /// and split as the scheme needs (`None` when that fails).
 pub type MeshAt<'a> = dyn Fn(usize) -> Option<Mesh> + 'a;
 
 /// Budgets a warning tries, from its estimate down, before it gives up naming one.
-const BUDGET_TRIALS: usize = 6;
+const BUDGET_TRIALS: usize = 10;
 
-/// Each budget tried is this fraction of the one before.
-const BUDGET_STEP: f64 = 0.8;
+/// Each budget tried is this fraction of the one before: near budgets differ in the
+/// few sliver faces a simplification leaves, so the steps are small.
+const BUDGET_STEP: f64 = 0.9;
 
 /// The budget the warnings suggest, tried: the model simplified to it builds clean
-/// ([`builds_clean`]). The first tried is the fewer of two estimates: where the median
-/// edge is [`SPREAD_MARGIN`] times the smallest edge at which the scheme's panels carry
-/// their labels, and where the faces, of that many times the smallest edge at which
-/// they hold their fastener holes, cover the model's area.
+/// ([`builds_clean`]). A budget makes even triangles, so the first tried is the number
+/// of edges whose triangles, [`SPREAD_MARGIN`] times the smallest that hold every
+/// panel's id (and every fastener hole), cover the model's area.
 pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_by(f64::total_cmp);
-    let median = *lengths.get(lengths.len() / 2)?;
-    let edges = lengths.len();
+    let edges = mesh.edge_count();
     let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
-    // At a fixed surface the edge count goes with the inverse square of the edge
-    // length.
-    let for_labels = smallest_buildable_edge(job, mesh)
-        .map(|edge| edges as f64 * (median / (SPREAD_MARGIN * edge)).powi(2));
-    let for_holes = smallest_fastened_edge(job)
-        .map(|edge| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2)));
-    let estimate = for_labels
+    let covering = |edge: f64| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2));
+    let estimate = [smallest_edge(job, 3, ids_fit), smallest_fastened_edge(job)]
         .into_iter()
-        .chain(for_holes)
+        .flatten()
+        .map(covering)
         .fold(f64::INFINITY, f64::min);
     checked_budget(job, round_down_2(estimate), edges, mesh_at)
 }
 
-/// A budget a warning may suggest because it was tried: from `estimate` down by a
-/// fifth at a time, the first at which the model, simplified as `--target-edges` would
-/// do it (`mesh_at`), builds clean ([`builds_clean`]); where a budget is below the
-/// fewest edges the model's topology allows, up by a quarter until one simplifies.
+/// A budget a warning may suggest because it was tried: from `estimate` (or a
+/// tenth below the model's `edges`, where that is fewer) down by a tenth at a
+/// time, the first at which the model, simplified as `--target-edges` would do it
+/// (`mesh_at`), builds clean ([`builds_clean`]); where a budget is below the
+/// fewest edges the model's topology allows, up by a ninth until one simplifies.
 /// `None` when a budget is not below the model's `edges`, or none of [`BUDGET_TRIALS`]
 /// budgets builds clean.
 fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
-    let mut budget = estimate.floor();
+    // A model close to building clean is tried a step below its own edges.
+    let mut budget = estimate
+        .min(round_down_2(edges as f64 * BUDGET_STEP))
+        .floor();
     let mut below_minimum = false;
     for _ in 0..BUDGET_TRIALS {
         if budget < 6.0 || budget >= edges as f64 {
@@ -316,12 +388,25 @@ fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> O
 }
 
 /// Whether the job's scheme builds `mesh` with nothing to warn of: every panel holds
-/// its id, and every connection the fastener holes asked for.
+/// its id, nearly every partner id fits, and every connection holds the fastener holes
+/// asked for.
 fn builds_clean(job: &Job, mesh: &Mesh) -> bool {
-    job.scheme
-        .build(mesh)
-        .is_ok_and(|output| output.unfastened.is_empty() && labels_fit(&output, false))
+    let Ok(output) = job.scheme.build(mesh) else {
+        return false;
+    };
+    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    output.unfastened.is_empty()
+        && crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold).is_ok_and(
+            |(_, left_out)| {
+                left_out.panel == 0
+                    && left_out.partner * PARTNERS_LEFT_OUT <= 2 * output.connections
+            },
+        )
 }
+
+/// A budget builds clean with at most one in this many partner ids left out (a partner
+/// id names the neighbour; a short flap may have no room for it).
+const PARTNERS_LEFT_OUT: usize = 10;
 
 /// Connections a warning names before it counts the rest.
 const NAMED: usize = 5;
@@ -331,18 +416,18 @@ const NAMED: usize = 5;
 const AREA_PER_EDGE: f64 = 0.288_675;
 
 /// Checks, after the scheme, that every connection holds a fastener hole when holes
-/// were asked for. A few without (sliver faces) are named with the fix; most without
-/// (a model too detailed for the fastener) gives one line with the `--target-edges`
-/// at which the faces hold one. [`refuse_unfastened`] makes either a refusal under
-/// `--strict`.
+/// were asked for. A few without (sliver faces) are named with the fix, a warning that
+/// `--strict` makes a refusal ([`refuse_unfastened`]); most without means faces too
+/// small for the fastener at this size, and the build stops ([`too_detailed`]).
 pub fn check_fasteners(
     job: &Job,
+    mesh: &Mesh,
     output: &SchemeOutput,
     budget: &dyn Fn() -> Option<usize>,
-) -> Option<String> {
+) -> Result<Option<String>> {
     let bare = &output.unfastened;
     if bare.is_empty() {
-        return None;
+        return Ok(None);
     }
     let panel = job.scheme.panel();
     let hole = format!(
@@ -351,25 +436,20 @@ pub fn check_fasteners(
         fmt_num(panel.hole_margin)
     );
     let (n, connections) = (bare.len(), output.connections);
-    let warning = if n as f64 > MOST_UNFASTENED * connections as f64 {
-        let fix = match budget() {
-            Some(b) => format!("--target-edges {b} makes faces large enough for one"),
-            None => "simplify the model (--target-edges) or build it larger (--size)".into(),
-        };
-        format!(
-            "no {hole} fits at {n} of {connections} connections: the faces are too small for it at this size; {fix}"
-        )
-    } else {
-        let mut names: Vec<String> = bare.iter().take(NAMED).map(|c| c.to_string()).collect();
-        if n > NAMED {
-            names.push(format!("and {} more", n - NAMED));
-        }
-        format!(
-            "{n} of {connections} connections hold no {hole}, their faces too thin for it: {}; a smaller --hole-margin or --hole-diameter, or a --target-edges budget, gives them one",
-            names.join(", ")
-        )
-    };
-    Some(warning)
+    if n as f64 > MOST_UNFASTENED * connections as f64 {
+        let what = format!(
+            "no {hole} fits at {n} of {connections} connections, their faces too small for it"
+        );
+        return too_detailed(job, mesh, &what, 2 * n > connections, budget).map(Some);
+    }
+    let mut names: Vec<String> = bare.iter().take(NAMED).map(|c| c.to_string()).collect();
+    if n > NAMED {
+        names.push(format!("and {} more", n - NAMED));
+    }
+    Ok(Some(format!(
+        "{n} of {connections} connections hold no {hole}, their faces too thin for it: {}; a smaller --hole-margin or --hole-diameter, or a --target-edges budget, gives them one",
+        names.join(", ")
+    )))
 }
 
 /// With `--strict`, the fasteners warning as a refusal (exit 1: the panels could not

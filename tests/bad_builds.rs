@@ -326,7 +326,7 @@ fn check_repaired(file: &str, bytes: &[u8], note: Option<&str>) {
     let model = sandbox.write(file, bytes);
     let out = sandbox.plant_sentinel();
     let before = sandbox.entries();
-    let run = build(file, &model, &out, &[]);
+    let run = build(file, &model, &out, &["--build-anyway"]);
     let err = &run.stderr;
     assert!(!err.contains("panicked"), "{file}: panic:\n{}", head(err));
     assert_eq!(run.code, Some(0), "{file}: exit code; stderr:\n{err}");

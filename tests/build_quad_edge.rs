@@ -919,7 +919,7 @@ fn check_holes(
 }
 
 /// The report's figures on connections with fewer holes than wanted: the scheme's note
-/// "X of Y connections have fewer than N fastener holes (but at least one)" and the
+/// "X of Y connections hold fewer fastener holes than asked (--holes N)" and the
 /// fasteners warning on the Z with none ("Z of Y connections hold no …", or "no … fits
 /// at Z of Y connections" when most have none), as (X + Z, Y, Z) if either is there.
 /// The note's N must be `wanted`.
@@ -935,7 +935,7 @@ fn fewer_holes_note(report: &str, wanted: usize) -> Option<(usize, usize, usize)
     };
     let note = report
         .lines()
-        .find(|l| l.contains(" connections have fewer than "))
+        .find(|l| l.contains(" connections hold fewer fastener holes than asked "))
         .map(|l| {
             let n = figures(l, "note: ");
             assert_eq!(n[2], wanted, "the wanted holes in {l:?}");
@@ -1522,7 +1522,7 @@ fn thesis_budgets_fasten_every_connection() {
         );
         let mut options = quad_options("4ft", 2, &out);
         options.holes = None;
-        options.model.target_edges = Some(1000);
+        options.model.target_edges = Some(unfold::config::TargetEdges::Count(1000));
         let job = resolve(options, &path);
         let p = pipeline(&job);
         assert!(p.output.unfastened.is_empty(), "{name}: the scheme's list");
@@ -1572,7 +1572,7 @@ fn only_small_faces_leave_a_connection_without_a_fastener() {
         let mut options = quad_options("4ft", 2, &out);
         options.holes = None;
         options.hole_diameter = Some(HOLE_FOR_SMALL_FACES.to_string());
-        options.model.target_edges = Some(1000);
+        options.model.target_edges = Some(unfold::config::TargetEdges::Count(1000));
         let job = resolve(options, &path);
         let p = pipeline(&job);
         assert_eq!(p.output.unfastened.len(), bare, "{name}: the scheme's list");
@@ -1670,9 +1670,13 @@ fn too_small_for_fasteners_gets_a_budget_and_strict_refuses() {
         "--out",
         strict.to_str().unwrap(),
     ]);
-    assert_eq!(run.code, Some(1), "{}", run.stderr);
+    // Faces too small for any hole stop the build before the nest, --strict or not.
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
     assert!(
-        run.stderr.contains(" fits at ") && run.stderr.contains("refused by --strict"),
+        run.stderr.contains(" fits at ")
+            && run
+                .stderr
+                .contains("stopped before laying out the sheets (nothing written)"),
         "{}",
         run.stderr
     );

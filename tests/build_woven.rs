@@ -275,8 +275,13 @@ fn lap_joints_without_a_hole_are_unfastened() {
         "--out",
         strict.to_str().unwrap(),
     ]);
-    assert_eq!(run.code, Some(1), "{}", run.stderr);
-    assert!(run.stderr.contains("refused by --strict"), "{}", run.stderr);
+    // A third of the joints without a hole: the build stops before the nest.
+    assert_eq!(run.code, Some(2), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("stopped before laying out the sheets"),
+        "{}",
+        run.stderr
+    );
     assert!(!strict.exists(), "--strict wrote {}", strict.display());
 }
 

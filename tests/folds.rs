@@ -239,7 +239,7 @@ fn shared_pipeline(name: &str, scheme: &str, target_edges: Option<usize>) -> Opt
         out: Some(tmp.path().join("out")),
         model: ModelOptions {
             size: Some("4ft".into()),
-            target_edges,
+            target_edges: target_edges.map(unfold::config::TargetEdges::Count),
             ..Default::default()
         },
         ..Default::default()

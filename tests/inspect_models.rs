@@ -270,7 +270,15 @@ fn inspect_lists_what_preparation_would_split_and_builds_agree() {
         let run = finish(
             unfold_command()
                 .arg(&concave)
-                .args(["--scheme", scheme, "--size", "300mm", "--quiet", "--out"])
+                .args([
+                    "--scheme",
+                    scheme,
+                    "--size",
+                    "300mm",
+                    "--quiet",
+                    "--build-anyway",
+                ])
+                .arg("--out")
                 .arg(&out),
         );
         assert_eq!(run.code, Some(0), "{}", run.stderr);

@@ -82,7 +82,7 @@ fn survey(
     let tmp = TempDir::new().unwrap();
     let mut o = options(scheme, size, 0, &tmp.path().join("out"));
     o.holes = None;
-    o.model.target_edges = target_edges;
+    o.model.target_edges = target_edges.map(unfold::config::TargetEdges::Count);
     let job = resolve(o, model);
     let loaded = unfold::run::load(&job).expect("loads");
     let prepared = unfold::run::prepare(&job, loaded).expect("prepares");

@@ -172,7 +172,7 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
 
     let mut o = options(scheme, size, 0, &out);
     o.holes = None;
-    o.model.target_edges = target_edges;
+    o.model.target_edges = target_edges.map(unfold::config::TargetEdges::Count);
     let mesh = common::build::pipeline(&resolve(o, model)).mesh;
 
     let mut named = BTreeSet::new();

@@ -228,7 +228,8 @@ fn small_components_are_removed() {
     assert_eq!(count(&genus2, "mesh.faces"), 50, "{genus2}");
 }
 
-/// The deviation the `simplified` note reports (model units).
+/// The deviation the `simplified` note reports (mm when built; without `--size` one
+/// model unit is 1 mm).
 fn reported_deviation(path: &std::path::Path, budget: &[&str]) -> f64 {
     let note = simplified_note(path, budget);
     let tail = note

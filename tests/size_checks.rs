@@ -169,14 +169,19 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
     for scheme in ["quad-edge", "half-edge"] {
         let out = tmp.path().join(scheme);
         let args = ["--scheme", scheme, "--size", "3ft", "--effort", "1"];
-        let mut strict = args.to_vec();
-        strict.push("--strict");
-        let run = build(&spot, &out, &strict);
+        // Without a budget the build stops before the nest, naming one.
+        let run = build(&spot, &out, &args);
         assert_refused(
             scheme,
             &run,
             &out,
-            &["too detailed for its size", "--target-edges "],
+            &[
+                "too detailed for its size",
+                "stopped before laying out the sheets (nothing written)",
+                "--target-edges ",
+                "--target-edges auto",
+                "--build-anyway builds it as it is",
+            ],
         );
         let budget_edges = number_after(&run.stderr, "--target-edges ").unwrap();
         let budget = budget_edges.to_string();
@@ -184,10 +189,9 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
             budget_edges < 8784,
             "{scheme}: {budget_edges} edges suggested"
         );
-        // The suggested budget, run, carries every panel's id and nearly every
-        // partner id, with no warning: the budget is worked out for even faces, and
-        // the smaller faces a simplified mesh keeps lose a partner id, so at most a
-        // tenth of them may be left out.
+        // The named budget, run, carries every panel's id and nearly every partner id,
+        // with no warning (the smaller faces a simplified mesh keeps may lose a partner
+        // id: at most a tenth of them).
         let mut suggested = args.to_vec();
         suggested.extend(["--target-edges", &budget, "--strict", "--quiet"]);
         let run = build(&spot, &out, &suggested);
@@ -211,7 +215,83 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
             "{scheme} at {budget} edges: {partners_out} of {partners} partner ids left out"
         );
         assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");
+
+        // `--target-edges auto` builds at that budget and says so.
+        let mut auto = args.to_vec();
+        auto.extend(["--target-edges", "auto", "--force"]);
+        let run = build(&spot, &out, &auto);
+        assert_eq!(run.code, Some(0), "{scheme} auto: {}", run.stderr);
+        assert!(
+            !run.stderr.contains("warning:"),
+            "{scheme} auto: {}",
+            run.stderr
+        );
+        assert!(
+            run.stderr
+                .contains(&format!("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to {budget} edges")),
+            "{scheme} auto: {}",
+            run.stderr
+        );
+        let manifest = read_manifest(&out);
+        assert_eq!(count(&manifest, "counts.panel_ids_left_out"), 0);
+
+        // `--build-anyway` builds the full model with the warning.
+        let mut anyway = args.to_vec();
+        anyway.extend(["--build-anyway", "--force", "--nester", "shelf"]);
+        let run = build(&spot, &out, &anyway);
+        assert_eq!(run.code, Some(0), "{scheme} anyway: {}", run.stderr);
+        assert!(
+            run.stderr
+                .contains("warning: the model is too detailed for its size")
+                && run.stderr.contains(&format!("--target-edges {budget}")),
+            "{scheme} anyway: {}",
+            run.stderr
+        );
     }
+}
+
+/// A model whose median edge is far below what the scheme's panels need stops before
+/// the scheme makes a panel, even with a `--target-edges` the user chose, and `auto`
+/// keeps a model that builds clean as it is.
+#[test]
+fn a_hopeless_budget_stops_and_auto_keeps_a_model_that_builds() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let genus2 = model("genus2");
+    let run = build(
+        &genus2,
+        &out,
+        &[
+            "--scheme",
+            "quad-edge",
+            "--size",
+            "40mm",
+            "--target-edges",
+            "100",
+        ],
+    );
+    assert_refused(
+        "genus2 at 40 mm",
+        &run,
+        &out,
+        &[
+            "too detailed for its size: its median edge would be",
+            "--build-anyway",
+        ],
+    );
+    let run = build(
+        &genus2,
+        &out,
+        &["--size", "300mm", "--target-edges", "auto"],
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("--target-edges auto: the model builds as it is at this size"),
+        "{}",
+        run.stderr
+    );
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
 }
 
 /// A panel larger than the usable sheet is a mistake in the options (exit 2), named
@@ -235,4 +315,44 @@ fn a_panel_larger_than_the_sheet_is_a_usage_error() {
             "use a larger --sheet or a smaller --size",
         ],
     );
+}
+
+/// A flat model (every vertex on one plane) is named as such: its panels would lie
+/// side by side with folds of nothing between them.
+#[test]
+fn a_flat_model_is_named_as_such() {
+    let tmp = TempDir::new().unwrap();
+    let mut obj = String::new();
+    for j in 0..=3 {
+        for i in 0..=3 {
+            obj.push_str(&format!("v {i} {j} 0\n"));
+        }
+    }
+    for j in 0..3 {
+        for i in 0..3 {
+            let v = |di: usize, dj: usize| (j + dj) * 4 + i + di + 1;
+            obj.push_str(&format!(
+                "f {} {} {} {}\n",
+                v(0, 0),
+                v(1, 0),
+                v(1, 1),
+                v(0, 1)
+            ));
+        }
+    }
+    let flat = tmp.path().join("flat.obj");
+    std::fs::write(&flat, obj).unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&flat, &out, &["--size", "300mm"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("flat.obj is flat: every vertex lies within 0 mm of one plane"),
+        "{}",
+        run.stderr
+    );
+    // A curved open model is not flat.
+    let run = build(&model("open-grid"), &out, &["--size", "300mm", "--force"]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(!run.stderr.contains(" is flat"), "{}", run.stderr);
 }

@@ -47,7 +47,7 @@ fn sweep_model(model: &Path, dir: &Path) -> PathBuf {
     }
     for budget in [1, 2, 4, 8].map(|k| k * SWEEP_EDGES) {
         let mut options = options("half-edge", "1ft", 0, &out);
-        options.model.target_edges = Some(budget);
+        options.model.target_edges = Some(unfold::config::TargetEdges::Count(budget));
         let job = resolve(options, model);
         let prepared = unfold::run::load(&job).and_then(|l| unfold::run::prepare(&job, l));
         if let Ok(prepared) = prepared {
@@ -106,6 +106,8 @@ fn every_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
                 cmd.arg(model)
                     .args(["--scheme", scheme, "--size", "1ft", "--kerf", kerf])
                     .args(["--effort", "1", "--format", "svg", "--quiet"])
+                    // Every stage is to run, on models too detailed for 1 ft too.
+                    .arg("--build-anyway")
                     .arg("--out")
                     .arg(&out)
                     .env_remove("RUST_BACKTRACE");

@@ -77,10 +77,15 @@ fn parser_errors_keep_the_parsers_help() {
             &["a similar argument exists: '--target-edges'"],
         ),
         (
-            "a number that is not one",
+            "a budget that is neither a number nor auto",
             vec![&model, "--target-edges", "lots"],
+            &["'lots' is not a number of edges or auto (like 600 or auto)"],
+        ),
+        (
+            "a number that is not one",
+            vec![&model, "--target-faces", "lots"],
             &[
-                "invalid value 'lots' for '--target-edges <N>'",
+                "invalid value 'lots' for '--target-faces <N>'",
                 "invalid digit",
             ],
         ),

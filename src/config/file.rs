@@ -10,7 +10,7 @@ use std::path::Path;
 
 use toml::de::{DeTable, DeValue};
 
-use super::{parse_length, parse_sheet, BuildOptions, LayerSettings, ModelOptions};
+use super::{parse_length, parse_sheet, BuildOptions, LayerSettings, ModelOptions, TargetEdges};
 use crate::error::{Error, Result};
 use crate::scheme::{OptionValues, Registry};
 
@@ -185,6 +185,8 @@ enum ValueKind {
     Sheet,
     /// A whole number in this range.
     Whole(i128, i128),
+    /// A whole number of edges, or "auto".
+    EdgeBudget,
     /// Any number.
     Number,
     /// A path or other text, as a string.
@@ -232,6 +234,8 @@ fn options(registry: &Registry) -> Vec<ConfigOption> {
                     whole(i32::MIN.into(), i32::MAX.into())
                 } else if id == TypeId::of::<f64>() {
                     Some(ValueKind::Number)
+                } else if id == TypeId::of::<TargetEdges>() {
+                    Some(ValueKind::EdgeBudget)
                 } else {
                     None
                 };
@@ -283,6 +287,13 @@ fn check_value(option: &ConfigOption, value: &DeValue) -> std::result::Result<()
             }
         }
         (ValueKind::Whole(..), _) => Err(format!("a whole number without quotes, like {key} = 4")),
+        (ValueKind::EdgeBudget, DeValue::Integer(i)) if !i.as_str().starts_with('-') => Ok(()),
+        (ValueKind::EdgeBudget, DeValue::String(s)) if s.trim().eq_ignore_ascii_case("auto") => {
+            Ok(())
+        }
+        (ValueKind::EdgeBudget, _) => Err(format!(
+            "a whole number of edges without quotes, like {key} = 600, or {key} = \"auto\""
+        )),
         (ValueKind::Number, DeValue::Integer(_) | DeValue::Float(_)) => Ok(()),
         (ValueKind::Number, _) => Err(format!("a number without quotes, like {key} = 0.5")),
         (ValueKind::Text, DeValue::String(_)) => Ok(()),
@@ -404,8 +415,9 @@ mod tests {
         assert_eq!(kind("quiet"), ValueKind::Switch);
         assert_eq!(kind("json"), ValueKind::Switch);
         assert_eq!(kind("face-scale"), ValueKind::Number);
+        assert_eq!(kind("target-edges"), ValueKind::EdgeBudget);
         assert_eq!(
-            kind("target-edges"),
+            kind("target-faces"),
             ValueKind::Whole(0, usize::MAX as i128)
         );
         assert_eq!(

@@ -154,9 +154,11 @@ pub struct ModelOptions {
     pub planarity_tol: Option<f64>,
 
     /// Simplify a triangle mesh to about this many edges (within 2 %), keeping its
-    /// holes and genus. [default: no simplification]
-    #[arg(long, value_name = "N", conflicts_with = "target_faces")]
-    pub target_edges: Option<usize>,
+    /// holes and genus; `auto` simplifies only a model too detailed for its size, to
+    /// the budget at which every panel holds its id and holes (tried, and named in the
+    /// report). [default: no simplification]
+    #[arg(long, value_name = "N|auto", conflicts_with = "target_faces")]
+    pub target_edges: Option<TargetEdges>,
 
     /// Simplify a triangle mesh to about this many faces, keeping its holes and genus.
     /// [default: no simplification]
@@ -174,6 +176,44 @@ pub struct ModelOptions {
     /// loose parts too small to build). [default: 0, keep every component]
     #[arg(long, value_name = "N")]
     pub min_component: Option<usize>,
+}
+
+/// A `--target-edges` value: a number of edges, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TargetEdges {
+    /// The budget a model too detailed for its size needs, found by trial builds.
+    Auto,
+    /// About this many edges.
+    Count(usize),
+}
+
+impl std::str::FromStr for TargetEdges {
+    type Err = String;
+
+    fn from_str(text: &str) -> std::result::Result<Self, String> {
+        if text.trim().eq_ignore_ascii_case("auto") {
+            return Ok(TargetEdges::Auto);
+        }
+        text.trim()
+            .parse()
+            .map(TargetEdges::Count)
+            .map_err(|_| format!("'{text}' is not a number of edges or auto (like 600 or auto)"))
+    }
+}
+
+impl<'de> Deserialize<'de> for TargetEdges {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Written {
+            Count(usize),
+            Text(String),
+        }
+        match Written::deserialize(d)? {
+            Written::Count(n) => Ok(TargetEdges::Count(n)),
+            Written::Text(text) => text.parse().map_err(serde::de::Error::custom),
+        }
+    }
 }
 
 /// How model units become millimetres.
@@ -260,6 +300,9 @@ pub struct ModelSettings {
     pub planarity_tol: f64,
     /// Simplification budget, if any.
     pub budget: Option<crate::mesh::simplify::Budget>,
+    /// `--target-edges auto`: a model too detailed for its size is simplified to the
+    /// budget its build finds (`budget` is then `None`).
+    pub auto_budget: bool,
     /// What simplification favours.
     pub simplify_mode: crate::mesh::simplify::SimplifyMode,
     /// Components with fewer faces than this are removed (0 keeps all).
@@ -312,17 +355,19 @@ impl ModelOptions {
                     "give --target-edges or --target-faces, not both".to_string(),
                 ))
             }
-            (Some(0), _) | (_, Some(0)) => {
+            (Some(TargetEdges::Count(0)), _) | (_, Some(0)) => {
                 return Err(Error::Usage(
                     "--target-edges and --target-faces must be positive".to_string(),
                 ))
             }
-            (Some(e), None) => Some(crate::mesh::simplify::Budget::Edges(e)),
+            (Some(TargetEdges::Auto), None) => None,
+            (Some(TargetEdges::Count(e)), None) => Some(crate::mesh::simplify::Budget::Edges(e)),
             (None, Some(f)) => Some(crate::mesh::simplify::Budget::Faces(f)),
             (None, None) => None,
         };
         Ok(ModelSettings {
             budget,
+            auto_budget: self.target_edges == Some(TargetEdges::Auto),
             simplify_mode: self.simplify_mode.unwrap_or_default(),
             min_component: self.min_component.unwrap_or(0),
             scaling: Scaling {
@@ -472,6 +517,13 @@ pub struct BuildOptions {
     #[arg(long)]
     #[serde(default)]
     pub strict: bool,
+
+    /// Build a model too detailed for its size (most panels without room for their
+    /// ids, or faces too small for any fastener hole) as it is, with a warning, instead
+    /// of stopping before the long stages with a budget that builds it. [default: off]
+    #[arg(long)]
+    #[serde(default)]
+    pub build_anyway: bool,
 
     /// Print the manifest summary (without the per-panel list) and stage times as
     /// JSON on stdout.
@@ -641,6 +693,8 @@ pub struct Job {
     pub map: bool,
     /// Refuse instead of warning about the build's size.
     pub strict: bool,
+    /// Build a model too detailed for its size instead of stopping.
+    pub build_anyway: bool,
     /// Print the summary as JSON on stdout.
     pub json: bool,
     /// Print nothing on stderr but errors.
@@ -742,6 +796,7 @@ impl BuildOptions {
             time_limit: self.time_limit.or(other.time_limit),
             stroke_width: self.stroke_width.or(other.stroke_width),
             strict: self.strict || other.strict,
+            build_anyway: self.build_anyway || other.build_anyway,
             json: self.json || other.json,
             quiet: self.quiet || other.quiet,
             model: self.model.or(other.model),
@@ -951,6 +1006,7 @@ impl BuildOptions {
             force: self.force,
             map: !self.no_map,
             strict: self.strict,
+            build_anyway: self.build_anyway,
             json: self.json,
             quiet: self.quiet,
             formats,

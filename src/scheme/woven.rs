@@ -745,7 +745,8 @@ impl Unrolled {
                 .map(|c| placed[c.line as usize][c.end as usize].unwrap_or_default())
                 .collect();
             self.area += crate::plane::area(&poly);
-            self.facets.push(FlatFacet::new(counter_clockwise(&poly), first_line));
+            self.facets
+                .push(FlatFacet::new(counter_clockwise(&poly), first_line));
             self.frames.push(frame);
         }
         self.lines.push([
@@ -777,7 +778,12 @@ impl FlatFacet {
     fn new(poly: Vec<DVec2>, piece: usize) -> FlatFacet {
         let lo = poly.iter().fold(DVec2::INFINITY, |m, &p| m.min(p));
         let hi = poly.iter().fold(DVec2::NEG_INFINITY, |m, &p| m.max(p));
-        FlatFacet { poly, piece, lo, hi }
+        FlatFacet {
+            poly,
+            piece,
+            lo,
+            hi,
+        }
     }
 }
 

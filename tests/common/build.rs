@@ -104,7 +104,7 @@ where
     finish(unfold_command().args(args))
 }
 
-/// Runs `unfold MODEL --scheme SCHEME --size SIZE --out OUT EXTRA…`, asserts success and
+/// Runs `unfold MODEL --scheme SCHEME --size SIZE --out OUT EXTRA… --build-anyway`, asserts success and
 /// returns the parsed `manifest.json` with the run (for its report on stderr).
 pub fn build_run(
     scheme: &str,
@@ -123,6 +123,9 @@ pub fn build_run(
         out.as_os_str(),
     ];
     args.extend(extra.iter().map(OsStr::new));
+    // Models more detailed than their size are built on purpose (size_checks.rs tests
+    // the stop).
+    args.push(OsStr::new("--build-anyway"));
     let run = unfold(&args);
     assert_eq!(run.code, Some(0), "unfold {args:?} failed:\n{}", run.stderr);
     (read_manifest(out), run)
@@ -140,6 +143,7 @@ pub fn assert_same_bytes_on_one_and_two_threads(model: &Path, args: &[&str]) {
                 .env("RAYON_NUM_THREADS", threads)
                 .arg(model)
                 .args(args)
+                .arg("--build-anyway")
                 .arg("--out")
                 .arg(&out),
         );
@@ -688,6 +692,9 @@ pub fn options(scheme: &str, size: &str, holes: u32, out: &Path) -> BuildOptions
         scheme: Some(scheme.to_string()),
         holes: Some(holes),
         out: Some(out.to_path_buf()),
+        // The geometry tests build models more detailed than their size on purpose;
+        // the stop itself is tested in size_checks.rs.
+        build_anyway: true,
         model: ModelOptions {
             size: Some(size.to_string()),
             ..Default::default()
