@@ -168,3 +168,206 @@ impl Mesh {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::build_from_faces;
+    use glam::DVec3;
+
+    /// A closed tetrahedron: every rule holds.
+    fn tetrahedron() -> Mesh {
+        let p = vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
+    }
+
+    /// Two triangles sharing the edge 1-2: an open square with one boundary loop.
+    fn square() -> Mesh {
+        let p = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+        ];
+        build_from_faces(p, &[[0u32, 1, 2], [2, 1, 3]]).unwrap()
+    }
+
+    /// A half-edge of `mesh` starting at `v` that satisfies `keep`.
+    fn outgoing(mesh: &Mesh, v: VertexId, keep: impl Fn(HalfedgeId) -> bool) -> HalfedgeId {
+        mesh.half_edges()
+            .find(|&h| mesh.origin(h) == v && keep(h))
+            .expect("such a half-edge")
+    }
+
+    #[test]
+    fn built_meshes_are_valid() {
+        assert_eq!(tetrahedron().validate(), Ok(()));
+        assert_eq!(square().validate(), Ok(()));
+    }
+
+    #[test]
+    fn tables_of_different_lengths_are_sizes() {
+        let mut odd = tetrahedron();
+        odd.half_edge_next.push(HalfedgeId(0));
+        assert_eq!(
+            odd.validate(),
+            Err(ConnectivityError::Sizes("odd number of half-edges"))
+        );
+        let mut short = tetrahedron();
+        short.vertex_source.pop();
+        assert_eq!(
+            short.validate(),
+            Err(ConnectivityError::Sizes("vertex tables"))
+        );
+        let mut faces = tetrahedron();
+        faces.face_source.push(0);
+        assert_eq!(
+            faces.validate(),
+            Err(ConnectivityError::Sizes("face tables"))
+        );
+    }
+
+    #[test]
+    fn a_handle_past_its_table_is_out_of_range() {
+        let mut mesh = tetrahedron();
+        mesh.half_edge_origin[3] = VertexId(99);
+        assert_eq!(
+            mesh.validate(),
+            Err(ConnectivityError::OutOfRange {
+                what: "origin",
+                at: HalfedgeId(3).to_string()
+            })
+        );
+        let mut mesh = tetrahedron();
+        mesh.face_half_edge[2] = HalfedgeId(99);
+        assert!(matches!(
+            mesh.validate(),
+            Err(ConnectivityError::OutOfRange {
+                what: "half-edge",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn a_prev_that_is_not_the_inverse_of_next_is_found() {
+        let mut mesh = tetrahedron();
+        let h = HalfedgeId(0);
+        let next = mesh.next(h);
+        mesh.half_edge_prev[next.index()] = next;
+        assert!(matches!(
+            mesh.validate(),
+            Err(ConnectivityError::NextPrev(_))
+        ));
+    }
+
+    #[test]
+    fn a_moved_origin_breaks_the_endpoints() {
+        let mut mesh = tetrahedron();
+        let h = HalfedgeId(0);
+        // h now starts where its twin starts.
+        mesh.half_edge_origin[h.index()] = mesh.origin(h.twin());
+        assert!(matches!(
+            mesh.validate(),
+            Err(ConnectivityError::Endpoints(_))
+        ));
+    }
+
+    #[test]
+    fn an_edge_without_faces_is_found() {
+        let mut mesh = tetrahedron();
+        let h = HalfedgeId(4);
+        mesh.half_edge_face[h.index()] = NO_FACE;
+        mesh.half_edge_face[h.twin().index()] = NO_FACE;
+        assert_eq!(mesh.validate(), Err(ConnectivityError::FacelessEdge(h)));
+    }
+
+    #[test]
+    fn a_loop_that_mixes_faces_is_found() {
+        let mut mesh = tetrahedron();
+        let f = FaceId(1);
+        let h = mesh.next(mesh.face_half_edge(f));
+        mesh.half_edge_face[h.index()] = 0;
+        assert!(matches!(
+            mesh.validate(),
+            Err(ConnectivityError::FaceLoop(_))
+        ));
+    }
+
+    #[test]
+    fn a_stored_half_edge_elsewhere_is_found() {
+        let mut mesh = tetrahedron();
+        let v = VertexId(2);
+        let elsewhere = outgoing(&mesh, VertexId(0), |_| true);
+        mesh.vertex_half_edge[v.index()] = elsewhere;
+        assert_eq!(mesh.validate(), Err(ConnectivityError::VertexHalfedge(v)));
+    }
+
+    #[test]
+    fn a_boundary_vertex_must_store_its_boundary_half_edge() {
+        let mut mesh = square();
+        // Vertex 1 is on the boundary and has an interior outgoing half-edge (to 2).
+        let v = VertexId(1);
+        let inner = outgoing(&mesh, v, |h| {
+            !mesh.is_boundary_half_edge(h) && !mesh.is_boundary_half_edge(h.twin())
+        });
+        mesh.vertex_half_edge[v.index()] = inner;
+        assert_eq!(
+            mesh.validate(),
+            Err(ConnectivityError::BoundaryVertexHalfedge(v))
+        );
+    }
+
+    #[test]
+    fn two_fans_at_one_vertex_are_a_non_manifold_vertex() {
+        // Two triangles meeting only at vertex 0: the builder splits it into one
+        // vertex per fan; joining the copies back makes a bow-tie.
+        let p = vec![
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(-1.0, 0.0, 0.0),
+            DVec3::new(0.0, -1.0, 0.0),
+        ];
+        let mut mesh = build_from_faces(p, &[[0u32, 1, 2], [0, 3, 4]]).unwrap();
+        assert_eq!(mesh.vertex_count(), 6, "the bow-tie was split");
+        assert_eq!(mesh.validate(), Ok(()));
+        let copy = VertexId(5);
+        for origin in &mut mesh.half_edge_origin {
+            if *origin == copy {
+                *origin = VertexId(0);
+            }
+        }
+        assert_eq!(
+            mesh.validate(),
+            Err(ConnectivityError::NonManifoldVertex(VertexId(0)))
+        );
+    }
+
+    #[test]
+    fn a_face_of_two_corners_is_degenerate() {
+        // Two vertices joined by two edges, each side a two-cornered face: every
+        // other rule holds.
+        let mesh = Mesh {
+            positions: vec![DVec3::ZERO, DVec3::X],
+            vertex_half_edge: vec![HalfedgeId(0), HalfedgeId(1)],
+            // h0: 0→1 and h3: 1→0 bound face 0; h2: 0→1 and h1: 1→0 bound face 1.
+            half_edge_next: vec![HalfedgeId(3), HalfedgeId(2), HalfedgeId(1), HalfedgeId(0)],
+            half_edge_prev: vec![HalfedgeId(3), HalfedgeId(2), HalfedgeId(1), HalfedgeId(0)],
+            half_edge_origin: vec![VertexId(0), VertexId(1), VertexId(0), VertexId(1)],
+            half_edge_face: vec![0, 1, 1, 0],
+            face_half_edge: vec![HalfedgeId(0), HalfedgeId(2)],
+            vertex_source: vec![0, 1],
+            face_source: vec![0, 1],
+        };
+        assert_eq!(
+            mesh.validate(),
+            Err(ConnectivityError::DegenerateFace(FaceId(0)))
+        );
+    }
+}
