@@ -175,6 +175,11 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
                 None => (options, nonplanar),
             };
             let settings = options.resolve()?;
+            if settings.auto_budget {
+                return Err(Error::Usage(
+                    "--target-edges auto: the budget is found by a build (it depends on the scheme, the sheet and the size); give inspect a number of edges".to_string(),
+                ));
+            }
             let nonplanar = nonplanar.unwrap_or(NonPlanar::Triangulate);
             let report = crate::inspect(&model, &settings, nonplanar)?;
             let text = if json {

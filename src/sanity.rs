@@ -340,7 +340,7 @@ const BUDGET_TRIALS: usize = 10;
 const BUDGET_STEP: f64 = 0.9;
 
 /// The budget the warnings suggest, tried: the model simplified to it builds clean
-/// ([`builds_clean`]). A budget makes even triangles, so the first tried is the number
+/// ([`trial`]). A budget makes even triangles, so the first tried is the number
 /// of edges whose triangles, [`SPREAD_MARGIN`] times the smallest that hold every
 /// panel's id (and every fastener hole), cover the model's area.
 pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
@@ -355,58 +355,107 @@ pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
     checked_budget(job, round_down_2(estimate), edges, mesh_at)
 }
 
-/// A budget a warning may suggest because it was tried: from `estimate` (or a
-/// tenth below the model's `edges`, where that is fewer) down by a tenth at a
-/// time, the first at which the model, simplified as `--target-edges` would do it
-/// (`mesh_at`), builds clean ([`builds_clean`]); where a budget is below the
-/// fewest edges the model's topology allows, up by a ninth until one simplifies.
-/// `None` when a budget is not below the model's `edges`, or none of [`BUDGET_TRIALS`]
-/// budgets builds clean.
+/// A budget a warning may suggest because it was tried: the first at which the model,
+/// simplified as `--target-edges` would do it (`mesh_at`), builds clean ([`trial`]).
+/// The first tried is `estimate` (or a tenth below the model's `edges`, where that is
+/// fewer); a budget too detailed is followed by a smaller one (by a tenth, or by 30 %
+/// when more than [`FAR_SHORT`] of the panels or connections go without), one too
+/// coarse (a panel larger than the sheet, or below the fewest edges the topology
+/// allows) by a larger one, and once both kinds were seen, by the budget halfway
+/// between them on a log scale. `None` when none of [`BUDGET_TRIALS`] builds clean.
 fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
-    // A model close to building clean is tried a step below its own edges.
-    let mut budget = estimate
-        .min(round_down_2(edges as f64 * BUDGET_STEP))
-        .floor();
-    let mut below_minimum = false;
+    let mut budget = round_down_2(estimate.min(edges as f64 * BUDGET_STEP));
+    // The largest budget found too coarse and the smallest found too detailed.
+    let (mut coarse, mut detailed) = (None::<f64>, None::<f64>);
     for _ in 0..BUDGET_TRIALS {
         if budget < 6.0 || budget >= edges as f64 {
             return None;
         }
-        let asked = budget as usize;
-        match mesh_at(asked) {
-            None => {
-                below_minimum = true;
-                budget = (budget / BUDGET_STEP).ceil();
+        let verdict = mesh_at(budget as usize).map_or(Trial::TooCoarse, |mesh| trial(job, &mesh));
+        let next = match verdict {
+            Trial::Clean => return Some(budget as usize),
+            Trial::TooDetailed { far } => {
+                detailed = Some(budget);
+                match coarse {
+                    Some(low) => (low * budget).sqrt(),
+                    None if far => budget * FAR_STEP,
+                    None => budget * BUDGET_STEP,
+                }
             }
-            Some(mesh) if builds_clean(job, &mesh) => return Some(asked),
-            // Fewer edges would be below the minimum again.
-            Some(_) if below_minimum => return None,
-            Some(_) => budget = round_down_2(budget * BUDGET_STEP),
+            Trial::TooCoarse => {
+                coarse = Some(budget);
+                match detailed {
+                    Some(high) => (high * budget).sqrt(),
+                    None => budget / FAR_STEP,
+                }
+            }
+        };
+        let next = round_down_2(next);
+        if next == budget
+            || coarse.is_some_and(|c| next <= c)
+            || detailed.is_some_and(|d| next >= d)
+        {
+            return None;
         }
+        budget = next;
     }
     None
 }
 
-/// Whether the job's scheme builds `mesh` with nothing to warn of: every panel holds
-/// its id, nearly every partner id fits, and every connection holds the fastener holes
-/// asked for.
-fn builds_clean(job: &Job, mesh: &Mesh) -> bool {
-    let Ok(output) = job.scheme.build(mesh) else {
-        return false;
-    };
-    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
-    output.unfastened.is_empty()
-        && crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold).is_ok_and(
-            |(_, left_out)| {
-                left_out.panel == 0
-                    && left_out.partner * PARTNERS_LEFT_OUT <= 2 * output.connections
-            },
-        )
+/// What one trial budget gave.
+enum Trial {
+    /// Nothing to warn of.
+    Clean,
+    /// Panels without their ids or connections without holes: fewer edges help;
+    /// `far` when more than [`FAR_SHORT`] of them go without.
+    TooDetailed { far: bool },
+    /// A panel larger than the sheet, or no build at all: more edges help.
+    TooCoarse,
 }
 
-/// A budget builds clean with at most one in this many partner ids left out (a partner
-/// id names the neighbour; a short flap may have no room for it).
-const PARTNERS_LEFT_OUT: usize = 10;
+/// A trial budget with more than this fraction of its panels without an id (or its
+/// connections without a hole) is far from clean.
+const FAR_SHORT: f64 = 0.01;
+
+/// The step from a budget far from clean.
+const FAR_STEP: f64 = 0.7;
+
+/// How the job's scheme builds `mesh`: clean when every panel holds its id, every
+/// connection holds the fastener holes asked for and every panel fits the sheet (what
+/// the build warns of; a partner id on a short flap may be left out, as the report
+/// counts).
+fn trial(job: &Job, mesh: &Mesh) -> Trial {
+    let Ok(output) = job.scheme.build(mesh) else {
+        return Trial::TooCoarse;
+    };
+    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    let Ok((flat, left_out)) =
+        crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+    else {
+        return Trial::TooCoarse;
+    };
+    let usable = (
+        job.sheet.width - 2.0 * job.margin,
+        job.sheet.height - 2.0 * job.margin,
+    );
+    let rotations = job.nest.search.rotations;
+    if !flat
+        .iter()
+        .all(|p| crate::plane::fits_rotated(&p.outer(), rotations, usable.0, usable.1))
+    {
+        return Trial::TooCoarse;
+    }
+    let connections = output.connections.max(1) as f64;
+    let panels = flat.len().max(1) as f64;
+    let short = (left_out.panel as f64 / panels).max(output.unfastened.len() as f64 / connections);
+    if short == 0.0 {
+        Trial::Clean
+    } else {
+        Trial::TooDetailed {
+            far: short > FAR_SHORT,
+        }
+    }
+}
 
 /// Connections a warning names before it counts the rest.
 const NAMED: usize = 5;

@@ -248,24 +248,7 @@ fn the_deviation_is_measured() {
     // A flat 8 x 8 grid of squares: whatever the simplifier collapses, the result lies
     // in the plane and covers the square (its corners are the grid's corners).
     let tmp = TempDir::new().unwrap();
-    let mut obj = String::new();
-    for j in 0..=8 {
-        for i in 0..=8 {
-            obj.push_str(&format!("v {i} {j} 0\n"));
-        }
-    }
-    for j in 0..8 {
-        for i in 0..8 {
-            let v = |di: usize, dj: usize| (j + dj) * 9 + i + di + 1;
-            obj.push_str(&format!(
-                "f {} {} {} {}\n",
-                v(0, 0),
-                v(1, 0),
-                v(1, 1),
-                v(0, 1)
-            ));
-        }
-    }
+    let obj = common::build::flat_grid_obj(8);
     let grid = tmp.path().join("flat.obj");
     std::fs::write(&grid, obj).unwrap();
     for mode in ["regular", "accurate"] {

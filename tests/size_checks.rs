@@ -189,9 +189,7 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
             budget_edges < 8784,
             "{scheme}: {budget_edges} edges suggested"
         );
-        // The named budget, run, carries every panel's id and nearly every partner id,
-        // with no warning (the smaller faces a simplified mesh keeps may lose a partner
-        // id: at most a tenth of them).
+        // The named budget, run, carries every panel's id, with no warning.
         let mut suggested = args.to_vec();
         suggested.extend(["--target-edges", &budget, "--strict", "--quiet"]);
         let run = build(&spot, &out, &suggested);
@@ -207,12 +205,6 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
         assert_eq!(
             ids_out, 0,
             "{scheme} at {budget} edges: {ids_out} of {panels} panel ids left out"
-        );
-        let partners = 2 * count(&manifest, "counts.connections");
-        let partners_out = count(&manifest, "counts.partner_ids_left_out");
-        assert!(
-            partners_out * 10 <= partners,
-            "{scheme} at {budget} edges: {partners_out} of {partners} partner ids left out"
         );
         assert!(manifest.get("warnings").is_none(), "{scheme}: {manifest}");
 
@@ -322,24 +314,7 @@ fn a_panel_larger_than_the_sheet_is_a_usage_error() {
 #[test]
 fn a_flat_model_is_named_as_such() {
     let tmp = TempDir::new().unwrap();
-    let mut obj = String::new();
-    for j in 0..=3 {
-        for i in 0..=3 {
-            obj.push_str(&format!("v {i} {j} 0\n"));
-        }
-    }
-    for j in 0..3 {
-        for i in 0..3 {
-            let v = |di: usize, dj: usize| (j + dj) * 4 + i + di + 1;
-            obj.push_str(&format!(
-                "f {} {} {} {}\n",
-                v(0, 0),
-                v(1, 0),
-                v(1, 1),
-                v(0, 1)
-            ));
-        }
-    }
+    let obj = common::build::flat_grid_obj(3);
     let flat = tmp.path().join("flat.obj");
     std::fs::write(&flat, obj).unwrap();
     let out = tmp.path().join("out");
@@ -355,4 +330,47 @@ fn a_flat_model_is_named_as_such() {
     let run = build(&model("open-grid"), &out, &["--size", "300mm", "--force"]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
     assert!(!run.stderr.contains(" is flat"), "{}", run.stderr);
+}
+
+/// A new user's first build of a shared model, in every scheme, without a budget:
+/// it builds with no warning, or it stops naming a budget that, run, builds with no
+/// warning (scripts/first-build runs every shared model at 2 ft and 4 ft).
+#[test]
+fn a_first_build_builds_clean_or_names_a_budget_that_does() {
+    let Some(shared) = shared_models("a_first_build_builds_clean_or_names_a_budget_that_does")
+    else {
+        return;
+    };
+    let spot = shared.join("spot.obj");
+    let tmp = TempDir::new().unwrap();
+    for scheme in ["half-edge", "quad-edge", "winged-edge", "woven", "net"] {
+        let out = tmp.path().join(scheme);
+        let args = ["--scheme", scheme, "--size", "2ft", "--nester", "shelf"];
+        let run = build(&spot, &out, &args);
+        if run.code == Some(0) {
+            assert!(!run.stderr.contains("warning:"), "{scheme}: {}", run.stderr);
+            continue;
+        }
+        assert_refused(
+            scheme,
+            &run,
+            &out,
+            &[
+                "too detailed for its size",
+                "stopped before laying out the sheets",
+            ],
+        );
+        let budget = number_after(&run.stderr, "--target-edges ")
+            .unwrap_or_else(|| panic!("{scheme}: no budget named: {}", run.stderr))
+            .to_string();
+        let mut suggested = args.to_vec();
+        suggested.extend(["--target-edges", &budget]);
+        let run = build(&spot, &out, &suggested);
+        assert_eq!(run.code, Some(0), "{scheme} at {budget}: {}", run.stderr);
+        assert!(
+            !run.stderr.contains("warning:"),
+            "{scheme} at {budget}: {}",
+            run.stderr
+        );
+    }
 }

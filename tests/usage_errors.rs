@@ -77,6 +77,14 @@ fn parser_errors_keep_the_parsers_help() {
             &["a similar argument exists: '--target-edges'"],
         ),
         (
+            "inspect with a budget only a build can find",
+            vec!["inspect", &model, "--target-edges", "auto"],
+            &[
+                "--target-edges auto: the budget is found by a build",
+                "give inspect a number",
+            ],
+        ),
+        (
             "a budget that is neither a number nor auto",
             vec![&model, "--target-edges", "lots"],
             &["'lots' is not a number of edges or auto (like 600 or auto)"],

@@ -819,3 +819,24 @@ pub fn compare_with_golden(out: &Path, golden: &Path, tmp: &Path, test: &str) ->
     }
     Golden::Matched
 }
+
+/// An OBJ of a flat `n` x `n` grid of unit squares in the plane z = 0.
+pub fn flat_grid_obj(n: usize) -> String {
+    let mut obj = String::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            obj.push_str(&format!("v {i} {j} 0\n"));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let v = |di: usize, dj: usize| (j + dj) * (n + 1) + i + di + 1;
+            let corners = [v(0, 0), v(1, 0), v(1, 1), v(0, 1)];
+            obj.push_str(&format!(
+                "f {} {} {} {}\n",
+                corners[0], corners[1], corners[2], corners[3]
+            ));
+        }
+    }
+    obj
+}
