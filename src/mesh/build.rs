@@ -273,3 +273,15 @@ pub fn build_from_faces<F: AsRef<[u32]>>(
     let polys = Polygons::from_faces(positions, faces);
     build_mesh(&polys, None, None).map(|(mesh, _)| mesh)
 }
+
+/// A closed regular tetrahedron, for the mesh modules' unit tests.
+#[cfg(test)]
+pub(crate) fn tetrahedron() -> Mesh {
+    let p = vec![
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 1.0),
+    ];
+    build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
+}

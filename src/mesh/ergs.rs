@@ -139,18 +139,7 @@ pub fn trace_cycles(mesh: &Mesh, twisted: &[bool]) -> Result<Vec<WeaveCycle>, Tr
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::build_from_faces;
-    use glam::DVec3;
-
-    fn tetrahedron() -> Mesh {
-        let p = vec![
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ];
-        build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
-    }
+    use crate::mesh::build::tetrahedron;
 
     #[test]
     fn untwisted_cycles_are_the_faces() {

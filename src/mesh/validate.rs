@@ -172,19 +172,9 @@ impl Mesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::build::tetrahedron;
     use crate::mesh::build_from_faces;
     use glam::DVec3;
-
-    /// A closed tetrahedron: every rule holds.
-    fn tetrahedron() -> Mesh {
-        let p = vec![
-            DVec3::new(1.0, 1.0, 1.0),
-            DVec3::new(1.0, -1.0, -1.0),
-            DVec3::new(-1.0, 1.0, -1.0),
-            DVec3::new(-1.0, -1.0, 1.0),
-        ];
-        build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
-    }
 
     /// Two triangles sharing the edge 1-2: an open square with one boundary loop.
     fn square() -> Mesh {
