@@ -181,7 +181,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
                 ));
             }
             let nonplanar = nonplanar.unwrap_or(NonPlanar::Triangulate);
-            let report = crate::inspect(&model, &settings, nonplanar)?;
+            let report = crate::inspect(&model, &settings, nonplanar, registry)?;
             let text = if json {
                 serde_json::to_string_pretty(&report)
                     .map_err(|e| Error::internal("writing the JSON summary", e))?

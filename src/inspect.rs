@@ -10,6 +10,7 @@ use crate::error::Result;
 use crate::load::load_model;
 use crate::mesh::read::Group;
 use crate::mesh::{self, GeometryFacts, Note, SoupFacts, Topology};
+use crate::scheme::Registry;
 use crate::{run, units};
 
 /// The physical size a model will be built at.
@@ -46,28 +47,37 @@ pub struct Inspection {
     pub ignored: Vec<(String, usize)>,
     /// Repairs and observations.
     pub notes: Vec<Note>,
-    /// Faces each kind of scheme would split before building panels (after
-    /// planarization, with `--nonplanar planarize`).
-    pub preparation: Preparation,
+    /// The faces each registered scheme would split before building panels (after
+    /// planarization, with `--nonplanar planarize`), in the registry's order.
+    pub preparation: Vec<Preparation>,
     /// The non-planar face policy the preview assumes.
     pub nonplanar: NonPlanar,
     /// What `--nonplanar planarize` would do (displacement in mm, as built).
     pub planarized: Option<mesh::planarize::PlanarizeReport>,
 }
 
-/// What preparation would do before building panels, per kind of scheme.
+/// What preparation would do before one scheme builds its panels.
 #[derive(Clone, Debug, Serialize)]
 pub struct Preparation {
-    /// Half-edge: faces split as non-planar, and as not star-shaped from their centre.
-    pub half_edge: [usize; 2],
-    /// Quad-edge and winged-edge: faces split as non-planar, and as not convex.
-    pub edge_schemes: [usize; 2],
+    /// The scheme's name.
+    pub scheme: &'static str,
+    /// The faces it needs: `convex`, or `star-shaped` from their centre.
+    pub faces: &'static str,
+    /// Faces split into triangles as non-planar.
+    pub non_planar: usize,
+    /// Faces split into triangles as not of the shape it needs.
+    pub misshapen: usize,
 }
 
 /// Reads, checks and measures a model, and previews what preparation would do with
 /// non-planar faces under `nonplanar` (planarization is run, on a copy scaled as the
 /// build scales it). Errors if it cannot be built at all.
-pub fn inspect(path: &Path, settings: &ModelSettings, nonplanar: NonPlanar) -> Result<Inspection> {
+pub fn inspect(
+    path: &Path,
+    settings: &ModelSettings,
+    nonplanar: NonPlanar,
+    registry: &Registry,
+) -> Result<Inspection> {
     let (raw, prepared) = load_model(path, settings)?;
     let geometry = prepared.mesh.geometry_facts(settings.planarity_tol);
     let mm = settings.checked_mm_per_unit(path, geometry.longest_side())?;
@@ -107,14 +117,20 @@ pub fn inspect(path: &Path, settings: &ModelSettings, nonplanar: NonPlanar) -> R
             ),
         });
     }
-    let split = |convex| {
-        let r = mesh::split::faces_to_split(&mesh, settings.planarity_tol, convex);
-        [r.non_planar.len(), r.not_star_shaped.len()]
-    };
-    let preparation = Preparation {
-        half_edge: split(false),
-        edge_schemes: split(true),
-    };
+    let preparation = registry
+        .schemes()
+        .iter()
+        .map(|scheme| {
+            let convex = scheme.needs_convex_faces();
+            let r = mesh::split::faces_to_split(&mesh, settings.planarity_tol, convex);
+            Preparation {
+                scheme: scheme.name(),
+                faces: if convex { "convex" } else { "star-shaped" },
+                non_planar: r.non_planar.len(),
+                misshapen: r.not_star_shaped.len(),
+            }
+        })
+        .collect();
     Ok(Inspection {
         preparation,
         path: path.display().to_string(),
@@ -248,11 +264,20 @@ impl Inspection {
                 units::short_number(r.max_displacement / self.physical.mm_per_unit)
             );
         }
-        let p = &self.preparation;
+        let splits: Vec<String> = self
+            .preparation
+            .iter()
+            .map(|p| {
+                format!(
+                    "{} {} non-planar + {} not {}",
+                    p.scheme, p.non_planar, p.misshapen, p.faces
+                )
+            })
+            .collect();
         let _ = writeln!(
             s,
-            "preparation: half-edge splits {} non-planar + {} concave faces into triangles; quad-/winged-edge split {} non-planar + {} non-convex",
-            p.half_edge[0], p.half_edge[1], p.edge_schemes[0], p.edge_schemes[1]
+            "preparation: faces split into triangles: {}",
+            splits.join("; ")
         );
         if !self.groups.is_empty() {
             let names: Vec<&str> = self.groups.iter().map(|g| g.name.as_str()).collect();

@@ -256,15 +256,33 @@ fn inspect_lists_what_preparation_would_split_and_builds_agree() {
     // but not convex (the edge schemes split them).
     let concave = crate_dir().join("models/concave.obj");
     let report = inspect(&concave, &[]);
+    let preparation = |scheme: &str| -> serde_json::Value {
+        report["preparation"]
+            .as_array()
+            .expect("a list")
+            .iter()
+            .find(|p| p["scheme"] == scheme)
+            .unwrap_or_else(|| panic!("{scheme} in {report}"))
+            .clone()
+    };
+    // Every registered scheme is listed, in the registry's order.
+    let listed: Vec<&str> = report["preparation"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["scheme"].as_str().unwrap())
+        .collect();
     assert_eq!(
-        report["preparation"]["half_edge"],
-        serde_json::json!([0, 0])
+        listed,
+        ["half-edge", "quad-edge", "winged-edge", "woven", "net"]
     );
-    assert_eq!(
-        report["preparation"]["edge_schemes"],
-        serde_json::json!([0, 2])
-    );
-    for (scheme, key) in [("half-edge", "half_edge"), ("quad-edge", "edge_schemes")] {
+    assert_eq!(preparation("half-edge")["faces"], "star-shaped");
+    assert_eq!(preparation("half-edge")["misshapen"], 0);
+    for scheme in ["quad-edge", "winged-edge", "woven", "net"] {
+        assert_eq!(preparation(scheme)["faces"], "convex", "{scheme}");
+        assert_eq!(preparation(scheme)["misshapen"], 2, "{scheme}");
+    }
+    for scheme in ["half-edge", "quad-edge"] {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("o");
         let run = finish(
@@ -284,8 +302,8 @@ fn inspect_lists_what_preparation_would_split_and_builds_agree() {
         assert_eq!(run.code, Some(0), "{}", run.stderr);
         let manifest = read_manifest(&out);
         let split = &manifest["input"]["faces_split"];
-        let preview = &report["preparation"][key];
-        assert_eq!(split["non_planar"], preview[0], "{scheme}");
-        assert_eq!(split["not_star_shaped"], preview[1], "{scheme}");
+        let preview = preparation(scheme);
+        assert_eq!(split["non_planar"], preview["non_planar"], "{scheme}");
+        assert_eq!(split["not_star_shaped"], preview["misshapen"], "{scheme}");
     }
 }

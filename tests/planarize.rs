@@ -132,12 +132,13 @@ fn inspect_previews_the_planarization_the_build_does() {
     );
     assert!(build.max_displacement > 1.0, "suzanne's quads move at 4 ft");
     // After planarization nothing is split for planarity; without it, 440 faces are.
-    assert_eq!(preview["preparation"]["half_edge"][0], 0);
+    assert_eq!(preview["preparation"][0]["scheme"], "half-edge");
+    assert_eq!(preview["preparation"][0]["non_planar"], 0);
     let triangulate = inspect_json(&path, &["--size", "4ft"]);
     assert!(triangulate["planarized"].is_null());
     assert_eq!(triangulate["nonplanar"], "triangulate");
     assert_eq!(
-        triangulate["preparation"]["half_edge"][0].as_u64(),
+        triangulate["preparation"][0]["non_planar"].as_u64(),
         Some(build.non_planar_before as u64)
     );
 }
