@@ -397,7 +397,7 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
                 "its face is far from planar (planarity error {warped:.3}): lower --planarity-tol so such faces are triangulated"
             )
         } else {
-            "try a smaller --tab-height or --flap-scale".to_string()
+            format!("try {}", job.scheme.scheme.overlap_fix())
         };
         return Err(Error::Build(format!(
             "panel {} overlaps itself when unrolled; {advice}",

@@ -166,6 +166,10 @@ impl Scheme for HalfEdge {
         false
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --tab-height"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,

@@ -49,6 +49,9 @@ pub trait Scheme: Send + Sync {
     fn defaults(&self) -> PanelDefaults;
     /// True when its faces must be convex (the rest are split into triangles first).
     fn needs_convex_faces(&self) -> bool;
+    /// What a user changes when one of its panels overlaps itself when unrolled (the
+    /// option that makes its connectors smaller, or its pieces shorter).
+    fn overlap_fix(&self) -> &'static str;
     /// Checks its own option `values` and fills in their defaults. An error is a usage
     /// message naming the option (`--bridge-scale: ...`).
     fn configure(
@@ -434,4 +437,34 @@ pub fn face_band(mesh: &Mesh, f: FaceId, s: f64) -> Vec<DVec3> {
     mesh.face_positions(f)
         .map(|v| s * v + (1.0 - s) * c)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every option a scheme's advice names is one of that scheme's own options.
+    #[test]
+    fn each_scheme_advises_its_own_options() {
+        for scheme in SCHEMES {
+            let own: Vec<String> = scheme
+                .options()
+                .iter()
+                .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
+                .collect();
+            let named: Vec<&str> = scheme
+                .overlap_fix()
+                .split(|c: char| c.is_whitespace() || c == '(' || c == ')' || c == ',')
+                .filter(|w| w.starts_with("--"))
+                .collect();
+            assert!(!named.is_empty(), "{}: no option named", scheme.name());
+            for option in named {
+                assert!(
+                    own.iter().any(|o| o == option),
+                    "{}: {option} is not among {own:?}",
+                    scheme.name()
+                );
+            }
+        }
+    }
 }

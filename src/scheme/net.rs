@@ -118,6 +118,10 @@ impl Scheme for Net {
         true
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --island-spread or --max-island-faces (smaller islands)"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,

@@ -57,6 +57,10 @@ impl Scheme for QuadEdge {
         true
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --flap-scale"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,

@@ -71,6 +71,10 @@ impl Scheme for WingedEdge {
         true
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --flap-scale"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,

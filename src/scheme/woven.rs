@@ -104,6 +104,10 @@ impl Scheme for Woven {
         true
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --curl-limit (shorter, straighter segments)"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,
