@@ -72,6 +72,10 @@ impl Scheme for Toy {
         false
     }
 
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --toy-shrink"
+    }
+
     fn configure(
         &self,
         values: &OptionValues,
