@@ -3,7 +3,9 @@
 //! millimetres), a model far too large for the sheets, or one so detailed for its size
 //! that its panels cannot carry their ids. Each gives a warning naming the fix with
 //! computed values; `--strict` turns warnings into refusals. A build whose typical edge
-//! is below [`MIN_MEDIAN_EDGE_MM`] is refused outright: no part of it could be cut.
+//! is below [`MIN_MEDIAN_EDGE_MM`] is refused outright: no part of it could be cut. A
+//! model too detailed for its size stops ([`Error::TooDetailed`]) with a budget that
+//! was tried ([`clean_budget`]), unless `--build-anyway`.
 
 use std::path::Path;
 
@@ -54,11 +56,10 @@ pub struct SizeCheck {
 /// Checks the scaled `mesh` of `job` against the sheet. Errors when the build is
 /// hopeless, or with `--strict` when anything was found.
 pub fn check_size(job: &Job, mesh: &Mesh) -> Result<SizeCheck> {
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
+    let lengths = mesh.sorted_edge_lengths();
     if lengths.is_empty() {
         return Ok(SizeCheck::default());
     }
-    lengths.sort_by(f64::total_cmp);
     let median = lengths[lengths.len() / 2];
     let longest = mesh.longest_side();
     let model = job.model_path.display();
@@ -174,8 +175,7 @@ pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<usize>) 
     if job.build_anyway {
         return Ok(());
     }
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_by(f64::total_cmp);
+    let lengths = mesh.sorted_edge_lengths();
     let Some(&median) = lengths.get(lengths.len() / 2) else {
         return Ok(());
     };
@@ -233,8 +233,7 @@ fn detail_fixes(job: &Job, mesh: &Mesh, budget: Option<usize>) -> String {
     if let Some(budget) = budget {
         fixes.push(format!("--target-edges {budget}"));
     }
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_by(f64::total_cmp);
+    let lengths = mesh.sorted_edge_lengths();
     if let (Some(buildable), false) = (smallest_buildable_edge(job, mesh), lengths.is_empty()) {
         // Or build it larger: the short edges grow with the model.
         let short = lengths[(lengths.len() as f64 * SHORT_TAIL) as usize];
@@ -332,7 +331,7 @@ const PROBE_SMALLEST: f64 = 0.5;
 /// and split as the scheme needs (`None` when that fails).
 pub type MeshAt<'a> = dyn Fn(usize) -> Option<Mesh> + 'a;
 
-/// Budgets a warning tries, from its estimate down, before it gives up naming one.
+/// Budgets a warning tries ([`checked_budget`]) before it gives up naming one.
 const BUDGET_TRIALS: usize = 10;
 
 /// Each budget tried is this fraction of the one before: near budgets differ in the

@@ -200,6 +200,13 @@ impl Mesh {
         self.position(a).distance(self.position(b))
     }
 
+    /// Every edge's length, shortest first (for medians and percentiles).
+    pub fn sorted_edge_lengths(&self) -> Vec<f64> {
+        let mut lengths: Vec<f64> = self.edges().map(|e| self.edge_length(e)).collect();
+        lengths.sort_unstable_by(f64::total_cmp);
+        lengths
+    }
+
     /// The half-edges of a face, counter-clockwise from its stored half-edge.
     pub fn face_half_edges(&self, f: FaceId) -> LoopIter<'_> {
         self.loop_from(self.face_half_edge(f))

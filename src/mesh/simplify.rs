@@ -543,8 +543,7 @@ fn manifold_triangles(mesh: &Mesh) -> (Vec<glam::DVec3>, Vec<[u32; 3]>) {
 
 /// The longest edge length and the 95th-percentile one, each over the median.
 fn edge_spread(mesh: &Mesh) -> (f64, f64) {
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_unstable_by(f64::total_cmp);
+    let lengths = mesh.sorted_edge_lengths();
     let at = |share: f64| {
         let k = ((lengths.len() as f64 - 1.0) * share).round() as usize;
         lengths.get(k).copied().unwrap_or(0.0)

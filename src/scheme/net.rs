@@ -925,8 +925,7 @@ fn place_tabs(
 
 /// Builds the islands of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
-    let mut lengths: Vec<f64> = mesh.edges().map(|e| mesh.edge_length(e)).collect();
-    lengths.sort_by(f64::total_cmp);
+    let lengths = mesh.sorted_edge_lengths();
     let cell = 2.0
         * lengths
             .get(lengths.len() / 2)
