@@ -44,12 +44,12 @@ struct EdgeUse {
 }
 
 /// Fold angles up to this (radians) are not scored: the two facets are coplanar.
-pub const FLAT_FOLD: f64 = 1e-9;
+pub const LEAST_SCORED_FOLD: f64 = 1e-9;
 
 /// Unrolls a panel. The first facet keeps its own frame (first corner at the origin,
 /// first edge along +x); every other facet is placed across a hinge.
 pub fn flatten<'a>(panel: impl Into<PanelRef<'a>>) -> Result<FlatPanel, FlattenError> {
-    unroll(panel.into(), FLAT_FOLD).map(|(flat, _)| flat)
+    unroll(panel.into(), LEAST_SCORED_FOLD).map(|(flat, _)| flat)
 }
 
 /// The isometry of every facet of `panel` between 3D and the flat panel that
@@ -57,16 +57,16 @@ pub fn flatten<'a>(panel: impl Into<PanelRef<'a>>) -> Result<FlatPanel, FlattenE
 /// label). Flat panels do not keep it (a million panels would carry a hundred bytes
 /// per facet for it), so it is computed again, by the same unrolling, where wanted.
 pub fn facet_frames<'a>(panel: impl Into<PanelRef<'a>>) -> Result<Vec<FacetFrame>, FlattenError> {
-    unroll(panel.into(), FLAT_FOLD).map(|(_, frames)| frames)
+    unroll(panel.into(), LEAST_SCORED_FOLD).map(|(_, frames)| frames)
 }
 
-/// The flat panel and its facet frames; hinges that fold by `flat_fold` (radians) or
+/// The flat panel and its facet frames; hinges that fold by `least_fold` (radians) or
 /// less are not scored.
-fn unroll(panel: PanelRef, flat_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
+fn unroll(panel: PanelRef, least_fold: f64) -> Result<(FlatPanel, Vec<FacetFrame>), FlattenError> {
     let fail_id = || panel.id().to_string();
     let normals = facet_normals(panel)?;
     let edges = edge_uses(panel);
-    let (hinges, folds) = hinges_and_folds(panel, &normals, &edges, flat_fold)?;
+    let (hinges, folds) = hinges_and_folds(panel, &normals, &edges, least_fold)?;
     let (points, frames) = lay_out_facets(panel, &normals, &hinges)?;
 
     let mut developability_error = 0.0f64;
@@ -149,13 +149,13 @@ fn edge_uses(panel: PanelRef) -> Vec<EdgeUse> {
 type Hinge = (u32, u32, u32, u32);
 
 /// The hinges between facets, both ways, sorted by their first facet (in edge order
-/// per facet), and the folds: the hinges that bend by more than `flat_fold`. An edge
+/// per facet), and the folds: the hinges that bend by more than `least_fold`. An edge
 /// used by three or more facets is an error.
 fn hinges_and_folds(
     panel: PanelRef,
     normals: &[DVec3],
     edges: &[EdgeUse],
-    flat_fold: f64,
+    least_fold: f64,
 ) -> Result<(Vec<Hinge>, Vec<Fold>), FlattenError> {
     let mut hinges: Vec<Hinge> = Vec::new();
     let mut folds = Vec::new();
@@ -168,7 +168,7 @@ fn hinges_and_folds(
                 hinges.push((f, g, a, b));
                 hinges.push((g, f, a, b));
                 let (nf, ng) = (normals[f as usize], normals[g as usize]);
-                if nf.angle_between(ng) > flat_fold {
+                if nf.angle_between(ng) > least_fold {
                     // The edge runs from → to in f.
                     let along =
                         panel.vertices[f_use.to as usize] - panel.vertices[f_use.from as usize];
@@ -257,35 +257,35 @@ pub fn unroll_and_fit<'a>(
     panel: impl Into<PanelRef<'a>>,
     options: LabelOptions,
 ) -> Result<(FlatPanel, LeftOut), FlattenError> {
-    unroll_fit(panel.into(), options, FLAT_FOLD)
+    unroll_fit(panel.into(), options, LEAST_SCORED_FOLD)
 }
 
-/// [`unroll_and_fit`], scoring only hinges that fold by more than `flat_fold`.
+/// [`unroll_and_fit`], scoring only hinges that fold by more than `least_fold`.
 fn unroll_fit(
     panel: PanelRef,
     options: LabelOptions,
-    flat_fold: f64,
+    least_fold: f64,
 ) -> Result<(FlatPanel, LeftOut), FlattenError> {
-    let (mut flat, frames) = unroll(panel, flat_fold)?;
+    let (mut flat, frames) = unroll(panel, least_fold)?;
     let left_out = fit_labels(&mut flat, panel, &frames, options);
     Ok((flat, left_out))
 }
 
 /// Unrolls every panel and fits its labels (the pipeline's flatten stage), in
-/// parallel, scoring the hinges that fold by more than `flat_fold` (radians; the
-/// scheme's, or [`FLAT_FOLD`]); the flat panels come in panel order, in one arena,
+/// parallel, scoring the hinges that fold by more than `least_fold` (radians; the
+/// scheme's, or [`LEAST_SCORED_FOLD`]); the flat panels come in panel order, in one arena,
 /// with how many labels were left out. On failure the error is that of the first
 /// panel, in panel order, that fails, whatever the thread count.
 pub fn unroll_all(
     panels: &Panels,
     options: LabelOptions,
-    flat_fold: f64,
+    least_fold: f64,
 ) -> Result<(FlatPanels, LeftOut), FlattenError> {
     let Tallied {
         panels: mut flat,
         tally: left_out,
     } = fill_arena(panels.len(), |i| {
-        crate::internal::for_panel(i, || unroll_fit(panels.get(i), options, flat_fold))
+        crate::internal::for_panel(i, || unroll_fit(panels.get(i), options, least_fold))
     })?;
     flat.shrink_to_fit();
     Ok((flat, left_out))
@@ -348,7 +348,7 @@ mod tests {
     /// hole on the folded facet.
     fn folded_strip() -> Panel {
         Panel::new(
-            Source::Face(0),
+            Source::face(0),
             vec![
                 DVec3::new(0.0, 0.0, 0.0),
                 DVec3::new(1.0, 0.0, 0.0),

@@ -219,7 +219,7 @@ mod tests {
         .map(|(x, y)| DVec2::new(x, y))
         .to_vec();
         FlatPanel {
-            source: Source::Face(0),
+            source: Source::face(0),
             points,
             outline: [vec![0, 1, 2, 3, 4, 5], vec![6, 7, 8, 9]]
                 .into_iter()

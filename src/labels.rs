@@ -369,7 +369,7 @@ mod tests {
     /// A 20 mm square facet hinged to a 0.2 mm wide strip folded up by 90°.
     fn square_and_strip(labels: Vec<Label>) -> Panel {
         Panel::new(
-            Source::Edge(7),
+            Source::edge(7),
             vec![
                 DVec3::new(0.0, 0.0, 0.0),
                 DVec3::new(20.0, 0.0, 0.0),
@@ -390,15 +390,15 @@ mod tests {
         let on_square = DVec3::new(4.0, 10.0, 0.0);
         let wanted = vec![
             // The panel id may move to the square: kept.
-            label(Name::Edge(7), LabelKind::Panel, 1, 3.0, on_strip),
+            label(Name::edge(7), LabelKind::Panel, 1, 3.0, on_strip),
             // A partner id on the 4 mm² strip: its box at 1.5 mm is larger.
-            label(Name::Edge(123), LabelKind::Partner, 1, 3.0, on_strip),
+            label(Name::edge(123), LabelKind::Partner, 1, 3.0, on_strip),
             // A mark on the square: kept.
-            label(Name::Vertex(5), LabelKind::Mark, 0, 3.0, on_square),
+            label(Name::vertex(5), LabelKind::Mark, 0, 3.0, on_square),
             // Wanted below the legible height: never tried.
-            label(Name::Face(9), LabelKind::Mark, 0, 1.0, on_square),
+            label(Name::face(9), LabelKind::Mark, 0, 1.0, on_square),
         ];
-        assert!(box_area(0.0, text_width(Name::Edge(123)), MIN_HEIGHT) > 1.01 * 4.0);
+        assert!(box_area(0.0, text_width(Name::edge(123)), MIN_HEIGHT) > 1.01 * 4.0);
         let pruned = square_and_strip(wanted.clone());
         let kinds: Vec<LabelKind> = pruned.labels.iter().map(|l| l.kind).collect();
         assert_eq!(kinds, [LabelKind::Panel, LabelKind::Mark]);

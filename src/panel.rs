@@ -17,73 +17,160 @@ pub mod surface;
 use arena::{arena_len, collect_arena};
 pub use arena::{fill_arena, Arena, ArenaIter, Views};
 
-/// Which mesh element a panel was made from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Source {
-    /// A face (half-edge scheme).
-    Face(u32),
-    /// An edge (quad-edge and winged-edge schemes).
-    Edge(u32),
-    /// A segment of a woven cycle.
-    Cycle {
-        /// The cycle.
-        cycle: u32,
-        /// The segment along it.
-        segment: u32,
-    },
-    /// An island of faces joined along folds (net scheme), numbered from 1.
-    Island(u32),
+/// A kind of printed id: its letter, what the map legend says of it, and the manifest
+/// fields of a panel so named. The kinds every scheme may use (faces, edges, vertices)
+/// are defined here; a scheme that makes its own kind of panel or mark defines its own
+/// as a `static` beside it, and labels, the map and the manifest read it as they read
+/// these.
+#[derive(Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct IdKind {
+    /// Printed before the number (`F`, `E`); empty for a bare number.
+    pub letter: &'static str,
+    /// What the map legend says an id of this kind is ("edge panel").
+    pub legend: &'static str,
+    /// The manifest field of a panel's number (`face` in `"face": 12`).
+    pub noun: &'static str,
+    /// The manifest field of a panel's part number, for ids with one (`C3.2`).
+    pub part_noun: &'static str,
 }
 
-impl Source {
-    /// The id printed for users (`F12`, `E123`, `C3.2`, `N4`).
-    pub fn name(self) -> Name {
-        match self {
-            Source::Face(f) => Name::Face(f),
-            Source::Edge(e) => Name::Edge(e),
-            Source::Cycle { cycle, segment } => Name::Segment { cycle, segment },
-            Source::Island(k) => Name::Island(k),
+/// Faces: `F12`, a face panel's id or a face mark.
+pub static FACE: IdKind = IdKind {
+    letter: "F",
+    legend: "face (a face panel, or the mark of a face)",
+    noun: "face",
+    part_noun: "",
+};
+
+/// Edges: `E123`, an edge panel's id.
+pub static EDGE: IdKind = IdKind {
+    letter: "E",
+    legend: "edge panel",
+    noun: "edge",
+    part_noun: "",
+};
+
+/// Vertices: `V7`, a corner mark.
+pub static VERTEX: IdKind = IdKind {
+    letter: "V",
+    legend: "vertex mark",
+    noun: "vertex",
+    part_noun: "",
+};
+
+/// A printed name: a panel's id, or what a label says: a kind's letter, a number and,
+/// for a part of a numbered whole, the part's number (`C3.2`). Kept as numbers and
+/// printed on demand, so a million panels carry no strings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Name {
+    /// What it names.
+    pub kind: &'static IdKind,
+    /// Its number.
+    pub number: u32,
+    /// The part's number (from 1), or 0 for a name without one.
+    pub part: u32,
+}
+
+impl Name {
+    /// The name `number` of `kind`.
+    pub const fn new(kind: &'static IdKind, number: u32) -> Name {
+        Name {
+            kind,
+            number,
+            part: 0,
         }
     }
-}
 
-/// A printed name: a panel's id, or what a label says. Kept as the element it names
-/// and printed on demand, so a million panels carry no strings.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Name {
-    /// A face: `F12` (half-edge panel ids, face marks).
-    Face(u32),
-    /// An edge: `E123` (edge panel ids).
-    Edge(u32),
-    /// A vertex: `V7` (corner marks).
-    Vertex(u32),
-    /// A woven cycle: `C3` (1-based).
-    Cycle(u32),
-    /// A segment of a woven cycle: `C3.2` (both 1-based).
-    Segment {
-        /// The cycle (1-based).
-        cycle: u32,
-        /// The segment along it (1-based).
-        segment: u32,
-    },
-    /// An island of a net: `N4` (1-based).
-    Island(u32),
-    /// The match number of a cut edge, the same on both sides: `17` (1-based).
-    Match(u32),
+    /// Part `part` (from 1) of `number` of `kind`.
+    pub const fn with_part(kind: &'static IdKind, number: u32, part: u32) -> Name {
+        Name { kind, number, part }
+    }
+
+    /// Face `k`: `F12`.
+    pub const fn face(k: u32) -> Name {
+        Name::new(&FACE, k)
+    }
+
+    /// Edge `k`: `E123`.
+    pub const fn edge(k: u32) -> Name {
+        Name::new(&EDGE, k)
+    }
+
+    /// Vertex `k`: `V7`.
+    pub const fn vertex(k: u32) -> Name {
+        Name::new(&VERTEX, k)
+    }
 }
 
 impl std::fmt::Display for Name {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Name::Face(k) => write!(f, "F{k}"),
-            Name::Edge(k) => write!(f, "E{k}"),
-            Name::Vertex(k) => write!(f, "V{k}"),
-            Name::Cycle(k) => write!(f, "C{k}"),
-            Name::Segment { cycle, segment } => write!(f, "C{cycle}.{segment}"),
-            Name::Island(k) => write!(f, "N{k}"),
-            Name::Match(k) => write!(f, "{k}"),
+        write!(f, "{}{}", self.kind.letter, self.number)?;
+        if self.part > 0 {
+            write!(f, ".{}", self.part)?;
         }
+        Ok(())
+    }
+}
+
+/// What of the model a panel covers: the map draws it there and writes the panel's id
+/// at its anchor, and the manifest lists the mesh elements.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Covers {
+    /// One face, whole; the id at its centre.
+    Face(u32),
+    /// One edge: the two triangles between the edge and the centres of its faces (the
+    /// edge panels of a face share it like the slices of a cake); the id at the edge's
+    /// midpoint.
+    Edge(u32),
+    /// A group of faces, entry k of the scheme output's `face_groups`; the id at the
+    /// group's anchor.
+    Faces(u32),
+    /// The panel's own facets, which lie over the surface (a ribbon); the id at the
+    /// centre of its middle facet.
+    Itself,
+}
+
+/// The faces a panel covers when it covers a group of them ([`Covers::Faces`]), and
+/// where the map shows its id: the scheme's choice (for example
+/// [`surface::group_anchor`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FaceGroup {
+    /// The mesh faces, in increasing order.
+    pub faces: Vec<u32>,
+    /// Where its id shows on the map (mm).
+    pub anchor: DVec3,
+}
+
+/// Where a panel comes from: its printed id and what of the model it covers. A scheme
+/// writes it; flattening, the map and the manifest read it without knowing the scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Source {
+    /// The id printed for users.
+    pub id: Name,
+    /// What of the model it covers.
+    pub covers: Covers,
+}
+
+impl Source {
+    /// The panel of face `f`, named `F<f>`.
+    pub const fn face(f: u32) -> Source {
+        Source {
+            id: Name::face(f),
+            covers: Covers::Face(f),
+        }
+    }
+
+    /// The panel of edge `e`, named `E<e>`.
+    pub const fn edge(e: u32) -> Source {
+        Source {
+            id: Name::edge(e),
+            covers: Covers::Edge(e),
+        }
+    }
+
+    /// The id printed for users (`F12`, `E123`, `C3.2`, `N4`).
+    pub fn name(self) -> Name {
+        self.id
     }
 }
 
@@ -1245,7 +1332,7 @@ mod tests {
             .collect();
         let labels = (0..k % 2)
             .map(|_| Label {
-                text: Name::Edge(k),
+                text: Name::edge(k),
                 anchor: DVec3::ZERO,
                 direction: DVec3::X,
                 height: 0.0,
@@ -1256,7 +1343,7 @@ mod tests {
             })
             .collect();
         Panel {
-            source: Source::Edge(k),
+            source: Source::edge(k),
             vertices,
             facets,
             holes,
@@ -1314,7 +1401,7 @@ mod tests {
         }
         assert_eq!(
             arena.iter().next_back().map(|p| p.id()),
-            Some(Name::Edge(6))
+            Some(Name::edge(6))
         );
 
         let flat_owned: Vec<FlatPanel> = (0..7).map(flat_fan).collect();
@@ -1329,10 +1416,10 @@ mod tests {
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
         // What a panel costs beside its items, against an owned panel's struct (the
         // figures in docs/architecture.md).
-        assert_eq!(std::mem::size_of::<PanelHead>(), 56);
-        assert_eq!(std::mem::size_of::<FlatHead>(), 56);
-        assert_eq!(std::mem::size_of::<Panel>(), 160);
-        assert_eq!(std::mem::size_of::<FlatPanel>(), 176);
+        assert_eq!(std::mem::size_of::<PanelHead>(), 72);
+        assert_eq!(std::mem::size_of::<FlatHead>(), 64);
+        assert_eq!(std::mem::size_of::<Panel>(), 168);
+        assert_eq!(std::mem::size_of::<FlatPanel>(), 184);
     }
 
     #[test]
@@ -1359,29 +1446,25 @@ mod tests {
 
     #[test]
     fn names_print_as_the_ids_users_read() {
-        assert_eq!(Name::Face(12).to_string(), "F12");
-        assert_eq!(Name::Edge(123).to_string(), "E123");
-        assert_eq!(Name::Vertex(7).to_string(), "V7");
-        assert_eq!(Name::Cycle(3).to_string(), "C3");
-        assert_eq!(
-            Name::Segment {
-                cycle: 3,
-                segment: 2
-            }
-            .to_string(),
-            "C3.2"
-        );
-        let source = Source::Cycle {
-            cycle: 3,
-            segment: 2,
+        assert_eq!(Name::face(12).to_string(), "F12");
+        assert_eq!(Name::edge(123).to_string(), "E123");
+        assert_eq!(Name::vertex(7).to_string(), "V7");
+        static CYCLE: IdKind = IdKind {
+            letter: "C",
+            legend: "cycle",
+            noun: "cycle",
+            part_noun: "segment",
         };
-        assert_eq!(
-            source.name(),
-            Name::Segment {
-                cycle: 3,
-                segment: 2
-            }
-        );
-        assert_eq!(Source::Edge(5).name().to_string(), "E5");
+        assert_eq!(Name::new(&CYCLE, 3).to_string(), "C3");
+        assert_eq!(Name::with_part(&CYCLE, 3, 2).to_string(), "C3.2");
+        static BARE: IdKind = IdKind {
+            letter: "",
+            legend: "match number",
+            noun: "match",
+            part_noun: "",
+        };
+        assert_eq!(Name::new(&BARE, 17).to_string(), "17");
+        assert_eq!(Source::edge(5).name().to_string(), "E5");
+        assert_eq!(Source::face(5).covers, Covers::Face(5));
     }
 }

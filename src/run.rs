@@ -22,7 +22,7 @@ use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 
 use crate::nest::{lay_out_observed, Layout, SheetSpec};
-use crate::panel::{FlatPanelRef, FlatPanels, FoldKind, Source};
+use crate::panel::{Covers, FlatPanelRef, FlatPanels, FoldKind};
 use crate::plane::is_simple;
 use crate::scheme::SchemeOutput;
 
@@ -376,8 +376,8 @@ pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
 /// itself is an error naming it. Then the cut loops move for the kerf.
 pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<Flat> {
     let mesh = &prepared.scheme_mesh.mesh;
-    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
-    let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+    let least_fold = job.scheme.least_scored_fold();
+    let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default(), least_fold)
         .map_err(|e| Error::internal("unrolling the panels", e))?;
     let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out, &|| {
         prepared.clean_budget(job)
@@ -385,8 +385,8 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
         // is a projection of a warped polygon.
-        let warped = match bad.source {
-            Source::Face(f) => {
+        let warped = match bad.source.covers {
+            Covers::Face(f) => {
                 let corners: Vec<glam::DVec3> = mesh.face_positions(FaceId(f)).collect();
                 crate::mesh::geometry::planarity_error(&corners)
             }
@@ -551,7 +551,7 @@ pub fn export(
         let surface = crate::panel::surface::panel_surface(
             &prepared.scheme_mesh.mesh,
             &output.panels,
-            &output.islands,
+            &output.face_groups,
         );
         let map = crate::export::map::assembly_map(&crate::export::map::MapInput {
             surface: &surface,
@@ -790,7 +790,7 @@ fn build_manifest(
     let lower_bound = (panel_area / usable).ceil() as usize;
     // Faces made by splitting or simplification have no face in the input file.
     let input_face = |f: u32| Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX);
-    let panels = manifest::panel_entries(flat, layout, input_face, &output.islands);
+    let panels = manifest::panel_entries(flat, layout, input_face, &output.face_groups);
     Manifest {
         tool: manifest::Tool {
             name: "unfold",

@@ -258,13 +258,13 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
     let mut degrees: Vec<usize> = mesh.faces().map(|f| mesh.face_degree(f)).collect();
     degrees.sort_unstable();
     let typical = degrees.get(degrees.len() / 2).copied().unwrap_or(3);
-    smallest_edge(job, typical, ids_fit)
+    smallest_edge(job, typical, |output| ids_fit(job, output))
 }
 
 /// Whether every panel of `output`, unrolled, holds its id.
-fn ids_fit(output: &SchemeOutput) -> bool {
-    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
-    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+fn ids_fit(job: &Job, output: &SchemeOutput) -> bool {
+    let least_fold = job.scheme.least_scored_fold();
+    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), least_fold)
         .is_ok_and(|(_, left_out)| left_out.panel == 0)
 }
 
@@ -346,11 +346,14 @@ pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
     let edges = mesh.edge_count();
     let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
     let covering = |edge: f64| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2));
-    let estimate = [smallest_edge(job, 3, ids_fit), smallest_fastened_edge(job)]
-        .into_iter()
-        .flatten()
-        .map(covering)
-        .fold(f64::INFINITY, f64::min);
+    let estimate = [
+        smallest_edge(job, 3, |output| ids_fit(job, output)),
+        smallest_fastened_edge(job),
+    ]
+    .into_iter()
+    .flatten()
+    .map(covering)
+    .fold(f64::INFINITY, f64::min);
     checked_budget(job, round_down_2(estimate), edges, mesh_at)
 }
 
@@ -427,9 +430,9 @@ fn trial(job: &Job, mesh: &Mesh) -> Trial {
     let Ok(output) = job.scheme.build(mesh) else {
         return Trial::TooCoarse;
     };
-    let flat_fold = output.flat_fold.unwrap_or(crate::flatten::FLAT_FOLD);
+    let least_fold = job.scheme.least_scored_fold();
     let Ok((flat, left_out)) =
-        crate::flatten::unroll_all(&output.panels, LabelOptions::default(), flat_fold)
+        crate::flatten::unroll_all(&output.panels, LabelOptions::default(), least_fold)
     else {
         return Trial::TooCoarse;
     };

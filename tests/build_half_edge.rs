@@ -30,7 +30,7 @@ use common::build::{
 };
 use unfold::config::Job;
 use unfold::mesh::EdgeId;
-use unfold::panel::{LabelKind, Source};
+use unfold::panel::{Covers, LabelKind};
 
 // =======================================================================================
 // Helpers (the shared ones are in tests/common/build.rs)
@@ -365,8 +365,8 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
             .collect();
         let sources: BTreeSet<u32> = owners
             .iter()
-            .map(|&k| match flat[k].source {
-                Source::Face(f) => f,
+            .map(|&k| match flat[k].source.covers {
+                Covers::Face(f) => f,
                 other => panic!("{what}: half-edge panel from {other:?}"),
             })
             .collect();
@@ -901,7 +901,7 @@ fn labels_are_inside_their_panels() {
             .map(|l| l.text.to_string())
             .collect();
         assert_eq!(own, [fp.id().to_string()], "{}: its own id once", fp.id());
-        let Source::Face(f) = fp.source else {
+        let Covers::Face(f) = fp.source.covers else {
             panic!("{}: not a face panel", fp.id())
         };
         // Partner labels name the neighbours across the face's edges.

@@ -15,7 +15,8 @@ use tempfile::TempDir;
 
 use common::build::*;
 use unfold::mesh::Mesh;
-use unfold::panel::{Name, Source};
+use unfold::panel::Covers;
+use unfold::scheme::net::{ISLAND, MATCH};
 
 /// Interior edges of a mesh (edges with a face on both sides).
 fn interior_edges(mesh: &Mesh) -> usize {
@@ -61,14 +62,20 @@ fn check_islands(what: &str, m: &Value, p: &Pipeline) -> usize {
     let mut tab_facets = 0;
     for panel in &p.panels {
         for label in &panel.labels {
-            if let Name::Match(k) = label.text {
-                *matches.entry(k).or_default() += 1;
+            if label.text.kind == &MATCH {
+                *matches.entry(label.text.number).or_default() += 1;
             }
         }
-        let Source::Island(k) = panel.source else {
+        let Covers::Faces(k) = panel.source.covers else {
             panic!("{what}: {} is not an island", panel.id());
         };
-        let faces = &p.output.islands[k as usize - 1];
+        assert_eq!(
+            panel.id().kind,
+            &ISLAND,
+            "{what}: {} is an island",
+            panel.id()
+        );
+        let faces = &p.output.face_groups[k as usize].faces;
         // Facets past the island's faces are tabs.
         for facet in panel.facets.iter().skip(faces.len()) {
             tab_facets += 1;
@@ -218,8 +225,8 @@ fn max_island_faces_caps_every_island() {
         &[("max-island-faces", "5")],
     );
     check_islands("icosahedron, at most 5 faces", &m, &p);
-    assert!(p.output.islands.iter().all(|f| f.len() <= 5));
-    assert!(p.output.islands.len() >= 4);
+    assert!(p.output.face_groups.iter().all(|g| g.faces.len() <= 5));
+    assert!(p.output.face_groups.len() >= 4);
 }
 
 #[test]

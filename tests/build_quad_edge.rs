@@ -34,7 +34,7 @@ use common::build::{
 use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use unfold::panel::{FlatPanel, Fold, Panel, Source};
+use unfold::panel::{Covers, FlatPanel, Fold, Panel};
 use unfold::scheme::edge_panel::EdgeOptions;
 use unfold::scheme::quad_edge::MAX_FLAP_SCALE;
 
@@ -84,8 +84,8 @@ fn face_corners(mesh: &Mesh) -> usize {
 
 /// The edge a panel was made from.
 fn edge_of(p: &FlatPanel) -> EdgeId {
-    match p.source {
-        Source::Edge(e) => EdgeId(e),
+    match p.source.covers {
+        Covers::Edge(e) => EdgeId(e),
         other => panic!("{}: a quad-edge panel made from {other:?}", p.id()),
     }
 }
@@ -1593,7 +1593,7 @@ fn only_small_faces_leave_a_connection_without_a_fastener() {
         let margin = job.scheme.panel().hole_margin;
         for c in &p.output.unfastened {
             let edges = c.panels.map(|n| match n {
-                unfold::panel::Name::Edge(e) => EdgeId(e),
+                n if n.kind == &unfold::panel::EDGE => EdgeId(n.number),
                 other => panic!("{other}: not an edge panel"),
             });
             let faces = |e: EdgeId| -> Vec<FaceId> {

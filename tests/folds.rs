@@ -13,7 +13,7 @@ use glam::DVec3;
 use tempfile::TempDir;
 use unfold::config::{BuildOptions, ModelOptions};
 use unfold::mesh::{EdgeId, FaceId, Mesh};
-use unfold::panel::{FlatPanel, FoldKind, Panel, Source};
+use unfold::panel::{Covers, FlatPanel, FoldKind, Panel};
 
 /// The kind of an interior mesh edge from its faces: valley where the second face
 /// rises above the first face's plane (the surface turns towards its outside).
@@ -160,12 +160,12 @@ fn check_folds(
                 );
             }
             // And the mesh edge under the fold, where there is one.
-            let edge = match panel.source {
-                Source::Edge(e) => Some(EdgeId(e)),
+            let edge = match panel.source.covers {
+                Covers::Edge(e) => Some(EdgeId(e)),
                 _ => edge_under(mesh, p, q, tol),
             };
             if let Some(e) = edge {
-                if let Source::Face(_) | Source::Edge(_) | Source::Island(_) = panel.source {
+                if !matches!(panel.source.covers, Covers::Itself) {
                     counts.on_edges += 1;
                     assert_eq!(
                         Some(fold.kind),

@@ -7,6 +7,11 @@
 //!
 //! The toy scheme: one panel per face, the face shrunk toward its centre by
 //! `--toy-shrink` (its face band), with the face id engraved on it.
+//!
+//! The pairs scheme makes its own kind of panel: two faces joined across an edge,
+//! folding along it, named `P1`, `P2`… with its own letter, its own manifest entry
+//! (`"pair"` and the faces) and section (`pairs`), its own words in the map legend and
+//! its own anchor on the map (the middle of the fold), all from this file.
 
 mod common;
 
@@ -16,9 +21,15 @@ use std::process::ExitCode;
 
 use tempfile::TempDir;
 
-use common::build::{check_sheets, count, model, read_manifest, DxfCheck};
-use unfold::mesh::{FaceId, Mesh};
-use unfold::panel::{Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use common::build::{
+    check_sheets, count, model, options, pipeline, read_manifest, resolve, DxfCheck,
+};
+use common::map::{face_seen, read_map};
+use glam::DVec3;
+use unfold::mesh::{FaceId, HalfedgeId, Mesh};
+use unfold::panel::{
+    Covers, FaceGroup, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source,
+};
 use unfold::record::Params;
 use unfold::scheme::{
     face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Registry, Scheme,
@@ -100,7 +111,7 @@ impl Configured for ToyOptions {
             facets.push(0..band.len() as u32);
             let centre = band.iter().copied().sum::<glam::DVec3>() / band.len() as f64;
             let label = Label {
-                text: Name::Face(f.0),
+                text: Name::face(f.0),
                 anchor: centre,
                 direction: (band[1] - band[0]).normalize(),
                 height: self.panel.label_height,
@@ -109,7 +120,7 @@ impl Configured for ToyOptions {
                 on_edge: false,
                 slide: 0.0,
             };
-            Panel::new(Source::Face(f.0), band, facets, Vec::new(), vec![label])
+            Panel::new(Source::face(f.0), band, facets, Vec::new(), vec![label])
         });
         Ok(SchemeOutput {
             panels,
@@ -125,12 +136,174 @@ impl Configured for ToyOptions {
 }
 
 // =======================================================================================
+// The pairs scheme
+// =======================================================================================
+
+struct Pairs;
+
+static PAIRS: Pairs = Pairs;
+
+/// Pairs of faces: `P3`.
+static PAIR: IdKind = IdKind {
+    letter: "P",
+    legend: "pair of faces (folds along its middle)",
+    noun: "pair",
+    part_noun: "",
+};
+
+#[derive(Debug)]
+struct PairOptions {
+    panel: PanelOptions,
+}
+
+impl Scheme for Pairs {
+    fn name(&self) -> &'static str {
+        "pairs"
+    }
+
+    fn about(&self) -> &'static str {
+        "faces joined in pairs across an edge (a test of a new kind of panel)"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        Vec::new()
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        PanelDefaults {
+            face_scale: 1.0,
+            holes: 0,
+            holes_allowed: &[0],
+        }
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        false
+    }
+
+    fn overlap_fix(&self) -> &'static str {
+        "a model with convex faces"
+    }
+
+    fn configure(
+        &self,
+        _values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        Ok(Box::new(PairOptions { panel }))
+    }
+}
+
+/// The faces of `mesh` in pairs: each face, in order, with its first neighbour (in its
+/// own edge order) not yet taken, across the half-edge they share; a face with none
+/// stays alone.
+fn pair_faces(mesh: &Mesh) -> Vec<(FaceId, Option<HalfedgeId>)> {
+    let mut taken = vec![false; mesh.face_count()];
+    let mut pairs = Vec::new();
+    for f in mesh.faces() {
+        if taken[f.index()] {
+            continue;
+        }
+        taken[f.index()] = true;
+        let across = mesh.face_half_edges(f).find(|&h| {
+            mesh.face(mesh.twin(h))
+                .is_some_and(|g| !std::mem::replace(&mut taken[g.index()], true))
+        });
+        pairs.push((f, across));
+    }
+    pairs
+}
+
+/// The panel of a pair: `f`'s corners, then the corners of the face across `h` but
+/// the two on the fold, which the facets share.
+fn pair_panel(mesh: &Mesh, number: u32, f: FaceId, h: Option<HalfedgeId>, height: f64) -> Panel {
+    let mut corners: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+    let mut facets = Loops::new();
+    facets.push(0..corners.len() as u32);
+    if let Some(g) = h.and_then(|h| mesh.face(mesh.twin(h))) {
+        let mut facet = Vec::new();
+        for v in mesh.face_vertices(g) {
+            let at = corners.iter().position(|&c| c == v.0).unwrap_or_else(|| {
+                corners.push(v.0);
+                corners.len() - 1
+            });
+            facet.push(at as u32);
+        }
+        facets.push(facet);
+    }
+    let vertices: Vec<DVec3> = corners
+        .iter()
+        .map(|&v| mesh.position(unfold::mesh::VertexId(v)))
+        .collect();
+    let label = Label {
+        text: Name::new(&PAIR, number),
+        anchor: mesh.face_centre(f),
+        direction: (vertices[1] - vertices[0]).normalize(),
+        height,
+        facet: 0,
+        kind: LabelKind::Panel,
+        on_edge: false,
+        slide: 0.0,
+    };
+    let source = Source {
+        id: Name::new(&PAIR, number),
+        covers: Covers::Faces(number - 1),
+    };
+    Panel::new(source, vertices, facets, Vec::new(), vec![label])
+}
+
+impl Configured for PairOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        let pairs = pair_faces(mesh);
+        let mut groups = Vec::new();
+        let mut section = Vec::new();
+        let mut panels = Vec::new();
+        for (k, &(f, h)) in pairs.iter().enumerate() {
+            let number = k as u32 + 1;
+            let mut faces: Vec<u32> = [Some(f), h.and_then(|h| mesh.face(mesh.twin(h)))]
+                .into_iter()
+                .flatten()
+                .map(|f| f.0)
+                .collect();
+            faces.sort_unstable();
+            // Its id shows on the map at the middle of its fold (a lone face's centre).
+            let anchor = h.map_or(mesh.face_centre(f), |h| {
+                0.5 * (mesh.position(mesh.origin(h)) + mesh.position(mesh.dest(h)))
+            });
+            let mut record = Params::default();
+            record.push("id", format!("P{number}"));
+            record.push("faces", faces.clone());
+            section.push(record);
+            groups.push(FaceGroup { faces, anchor });
+            panels.push(pair_panel(mesh, number, f, h, self.panel.label_height));
+        }
+        let mut manifest = Params::default();
+        manifest.push_records("pairs", section);
+        Ok(SchemeOutput {
+            panels: panels.into_iter().collect(),
+            connections: mesh.edge_count() - groups.iter().filter(|g| g.faces.len() == 2).count(),
+            manifest,
+            face_groups: groups,
+            ..SchemeOutput::default()
+        })
+    }
+
+    fn params(&self) -> Params {
+        Params::default()
+    }
+}
+
+// =======================================================================================
 // Tests
 // =======================================================================================
 
 /// `unfold ARGS…` through the binary's entry point with the toy scheme registered.
 fn unfold_with_toy(args: &[&dyn AsRef<std::ffi::OsStr>]) -> ExitCode {
-    let registry = Registry::default().with(&TOY);
+    let registry = Registry::default().with(&TOY).with(&PAIRS);
     let argv: Vec<OsString> = std::iter::once(OsString::from("unfold"))
         .chain(args.iter().map(|a| a.as_ref().to_os_string()))
         .collect();
@@ -258,4 +431,117 @@ fn the_toy_option_is_a_config_key_and_is_checked() {
         .get_possible_values()
         .iter()
         .any(|v| v.get_name() == "toy"));
+}
+
+#[test]
+fn a_scheme_with_its_own_kind_of_panel_is_named_in_the_manifest_and_on_the_map() {
+    let tmp = TempDir::new().unwrap();
+    let model = model("icosahedron");
+    let out = tmp.path().join("pairs");
+    let code = unfold_with_toy(&[
+        &model,
+        &"--scheme",
+        &"pairs",
+        &"--size",
+        &"300mm",
+        &"--out",
+        &out,
+        &"--quiet",
+    ]);
+    assert_eq!(code, ExitCode::SUCCESS);
+    let m = read_manifest(&out);
+
+    // The 20 faces of the icosahedron, each in exactly one panel of its own kind:
+    // a pair, or a face the greedy pairing left alone.
+    let panels = m["panels"].as_array().unwrap();
+    let mut covered = Vec::new();
+    let mut pairs = 0;
+    for (k, p) in panels.iter().enumerate() {
+        let number = k as u64 + 1;
+        assert_eq!(p["id"], format!("P{number}"));
+        let source = &p["source"];
+        assert_eq!(source["pair"], number, "{source}");
+        let faces: Vec<u64> = source["faces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_u64().unwrap())
+            .collect();
+        assert!((1..=2).contains(&faces.len()), "{source}");
+        pairs += usize::from(faces.len() == 2);
+        // The icosahedron's faces are the input's: no split, no simplification.
+        assert_eq!(source["input_faces"], source["faces"], "{source}");
+        covered.extend(faces);
+    }
+    assert_eq!(panels.len(), 20 - pairs);
+    assert!(pairs >= 8, "{pairs} pairs");
+    covered.sort_unstable();
+    assert_eq!(covered, (0..20).collect::<Vec<u64>>());
+    // Its own manifest section, beside the shared ones.
+    let section = m["pairs"].as_array().expect("a pairs section");
+    assert_eq!(section.len(), panels.len());
+    assert_eq!(section[3]["id"], "P4");
+    assert_eq!(section[3]["faces"], panels[3]["source"]["faces"]);
+    check_sheets(&out, &m, DxfCheck::All);
+
+    // The map: the legend in the scheme's words, every id at its own place.
+    let svg = std::fs::read_to_string(out.join("icosahedron-map.svg")).unwrap();
+    assert!(
+        svg.contains("Ids: P pair of faces (folds along its middle)."),
+        "the legend names the pairs"
+    );
+    let mut o = options("half-edge", "300mm", 0, &out);
+    o.holes = None;
+    let mesh = pipeline(&resolve(o, &model)).mesh;
+    // Two whole faces per panel, unrolled: the panels' area is the model's.
+    let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
+    let panel_area = m["panel_area"].as_f64().unwrap();
+    assert!(
+        (panel_area - area).abs() < 1e-6 * area,
+        "{panel_area} mm², {area} mm²"
+    );
+    let faces_of = |id: &str| -> Vec<u32> {
+        let k: usize = id[1..].parse().unwrap();
+        panels[k - 1]["source"]["faces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_u64().unwrap() as u32)
+            .collect()
+    };
+    let (mut named, mut at_fold, mut shown) = (std::collections::BTreeSet::new(), 0, 0);
+    for view in read_map(&svg) {
+        for (id, at) in &view.ids {
+            let own = faces_of(id);
+            let seen = face_seen(&mesh, &view, *at);
+            assert!(
+                seen.is_some_and(|f| own.contains(&f)),
+                "{}: {id} drawn over face {seen:?}, not its own {own:?}",
+                view.name
+            );
+            // The anchor the scheme chose: the middle of the edge its faces share (a
+            // lone face's centre).
+            let fold = match own[..] {
+                [f, g] => {
+                    let h = mesh
+                        .face_half_edges(FaceId(f))
+                        .find(|&h| mesh.face(mesh.twin(h)) == Some(FaceId(g)))
+                        .unwrap();
+                    0.5 * (mesh.position(mesh.origin(h)) + mesh.position(mesh.dest(h)))
+                }
+                _ => mesh.face_centre(FaceId(own[0])),
+            };
+            if view.page_point(fold).distance(*at) < 1e-3 {
+                at_fold += 1;
+            }
+            shown += 1;
+            named.insert(id.clone());
+        }
+    }
+    assert_eq!(named.len(), panels.len(), "every panel named on the map");
+    // An id crowded at its anchor moves nearer the middle of its panel: most stay.
+    assert!(
+        2 * at_fold > shown,
+        "{at_fold} of {shown} ids at their anchor"
+    );
 }

@@ -5,7 +5,7 @@
 use serde::Serialize;
 
 use crate::nest::Layout;
-use crate::panel::{FlatPanels, Source};
+use crate::panel::{Covers, FaceGroup, FlatPanels, Source};
 use crate::record::Params;
 
 pub use crate::record::round4;
@@ -208,40 +208,9 @@ pub struct SheetEntry {
     pub time_s: f64,
 }
 
-/// Where a panel came from (`{"face": 12}`).
-#[derive(Clone, Debug, Serialize)]
-#[serde(untagged)]
-pub enum PanelSource {
-    /// A face.
-    Face {
-        /// Face index in the prepared mesh.
-        face: u32,
-        /// Face index in the input file (none after simplification).
-        input_face: Option<u32>,
-    },
-    /// An edge.
-    Edge {
-        /// Edge index.
-        edge: u32,
-    },
-    /// A woven cycle segment.
-    Cycle {
-        /// Cycle.
-        cycle: u32,
-        /// Segment.
-        segment: u32,
-    },
-    /// An island of faces (net scheme).
-    Island {
-        /// Island number (from 1).
-        island: u32,
-        /// Its faces, as indices in the prepared mesh.
-        faces: Vec<u32>,
-        /// The same in the input file (`null` for a face made by splitting or
-        /// simplification).
-        input_faces: Vec<Option<u32>>,
-    },
-}
+/// Where a panel came from (`{"face": 12, "input_face": 12}`), written by
+/// [`panel_source`].
+pub type PanelSource = Params;
 
 /// One panel.
 #[derive(Clone, Debug, Serialize)]
@@ -309,14 +278,13 @@ pub struct Manifest {
     pub panels: Vec<PanelEntry>,
 }
 
-/// Every panel's entry: id, sheet, area, source (with its face in the input file, from
-/// `input_face`; an island's faces from `islands`), placement and developability error,
-/// in panel order.
+/// Every panel's entry: id, sheet, area, source (see [`panel_source`]), placement and
+/// developability error, in panel order.
 pub fn panel_entries(
     flat: &FlatPanels,
     layout: &Layout,
     input_face: impl Fn(u32) -> Option<u32>,
-    islands: &[Vec<u32>],
+    face_groups: &[FaceGroup],
 ) -> Vec<PanelEntry> {
     flat.iter()
         .zip(&layout.placements)
@@ -324,25 +292,7 @@ pub fn panel_entries(
             id: p.id().to_string(),
             sheet: placement.sheet + 1,
             area: round4(p.area),
-            source: match p.source {
-                Source::Face(f) => PanelSource::Face {
-                    face: f,
-                    input_face: input_face(f),
-                },
-                Source::Edge(e) => PanelSource::Edge { edge: e },
-                Source::Cycle { cycle, segment } => PanelSource::Cycle { cycle, segment },
-                Source::Island(island) => {
-                    let faces = islands
-                        .get(island as usize - 1)
-                        .cloned()
-                        .unwrap_or_default();
-                    PanelSource::Island {
-                        island,
-                        input_faces: faces.iter().map(|&f| input_face(f)).collect(),
-                        faces,
-                    }
-                }
-            },
+            source: panel_source(p.source, face_groups, &input_face),
             x: round4(placement.translation.x),
             y: round4(placement.translation.y),
             rotation_deg: round4(placement.rotation.to_degrees()),
@@ -350,6 +300,47 @@ pub fn panel_entries(
             developability_error: round_nm(p.developability_error),
         })
         .collect()
+}
+
+/// A panel's source for the manifest: its number under its kind's noun (`"edge": 7`),
+/// its part's number under the kind's part noun (`"segment": 2`), then the mesh
+/// elements it covers (`face` and `input_face`, `edge`, or `faces` and `input_faces`:
+/// the face in the input file is `null` for one made by splitting or simplification),
+/// each field written once: a face panel named after its face gives `"face"` once.
+pub fn panel_source(
+    source: Source,
+    face_groups: &[FaceGroup],
+    input_face: impl Fn(u32) -> Option<u32>,
+) -> PanelSource {
+    let mut fields = Params::default();
+    let mut push = |name: &str, value: serde_json::Value| {
+        if !fields.0.iter().any(|(n, _)| n == name) {
+            fields.push(name, value);
+        }
+    };
+    let id = source.id;
+    push(id.kind.noun, id.number.into());
+    if id.part > 0 {
+        push(id.kind.part_noun, id.part.into());
+    }
+    match source.covers {
+        Covers::Face(f) => {
+            push("face", f.into());
+            push("input_face", input_face(f).into());
+        }
+        Covers::Edge(e) => push("edge", e.into()),
+        Covers::Faces(k) => {
+            let faces = face_groups
+                .get(k as usize)
+                .map(|g| g.faces.clone())
+                .unwrap_or_default();
+            let inputs: Vec<Option<u32>> = faces.iter().map(|&f| input_face(f)).collect();
+            push("faces", faces.into());
+            push("input_faces", inputs.into());
+        }
+        Covers::Itself => {}
+    }
+    fields
 }
 
 /// How many connections have 0, 1, 2 … fastener holes: each hole goes through both

@@ -17,7 +17,7 @@ use glam::{DVec2, DVec3};
 use super::fmt_mm;
 use crate::nest::Layout;
 use crate::panel::surface::{PanelSurface, Patch};
-use crate::panel::Panels;
+use crate::panel::{IdKind, Panels};
 
 /// A direction the model is seen from.
 struct View {
@@ -413,12 +413,40 @@ fn legend(out: &mut String, input: &MapInput, page_h: f64, named: usize) {
     }
     let _ = writeln!(
         out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"3.5\">Ids: E edge panel, F face (half-edge panel; a mark on a flap), V vertex mark, C woven cycle (C3.2: its segment 2), N net island (numbers on a net pair the sides of a cut). {named} of {} panels named; one crowded out of a view is named in another.</text>",
+        "<text x=\"{}\" y=\"{}\" font-size=\"3.5\">Ids: {}. {named} of {} panels named; one crowded out of a view is named in another.</text>",
         fmt_mm(BORDER),
         fmt_mm(y + 11.0),
+        escape(&id_legend(input.panels)),
         input.panels.len()
     );
     out.push_str("</g>\n");
+}
+
+/// What each kind of id on the panels means, in the schemes' own words: the panels'
+/// kinds first, then those only labels use, each in the order first met.
+fn id_legend(panels: &Panels) -> String {
+    let mut kinds: Vec<&'static IdKind> = Vec::new();
+    let mut meet = |kind: &'static IdKind| {
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    };
+    for panel in panels.iter() {
+        meet(panel.id().kind);
+    }
+    for panel in panels.iter() {
+        for label in panel.labels {
+            meet(label.text.kind);
+        }
+    }
+    let words: Vec<String> = kinds
+        .iter()
+        .map(|k| match k.letter {
+            "" => k.legend.to_string(),
+            letter => format!("{letter} {}", k.legend),
+        })
+        .collect();
+    words.join(", ")
 }
 
 fn vec3(v: DVec3) -> String {

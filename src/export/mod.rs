@@ -470,7 +470,7 @@ mod tests {
         let mut outline = Loops::new();
         outline.push(0..4);
         let panel = FlatPanel {
-            source: Source::Edge(7),
+            source: Source::edge(7),
             points: vec![
                 DVec2::new(0.0, 0.0),
                 DVec2::new(100.0, 0.0),
@@ -481,7 +481,7 @@ mod tests {
             folds: Vec::new(),
             holes: Vec::new(),
             labels: vec![FlatLabel {
-                text: Name::Edge(7),
+                text: Name::edge(7),
                 center: DVec2::new(50.0, 50.0),
                 direction: DVec2::X,
                 height: 5.0,

@@ -1,12 +1,9 @@
 //! Where each panel sits on the model: the piece of surface it covers and the point its
-//! id is shown at, for the assembly map. A face panel covers its face; an edge panel
-//! the two triangles between its edge and the centres of the edge's faces (so the
-//! edge panels of a face share it like the slices of a cake); a woven segment its own
-//! ribbon, which lies over the surface; an island its faces.
+//! id is shown at, for the assembly map, from what its [`Covers`] says.
 
 use glam::DVec3;
 
-use super::{Panels, Source};
+use super::{Covers, FaceGroup, Panels};
 use crate::mesh::geometry::vector_area;
 use crate::mesh::{EdgeId, FaceId, Mesh};
 
@@ -27,24 +24,24 @@ pub struct Patch {
 pub struct PanelSurface {
     /// Every panel's patches, in panel order.
     pub patches: Vec<Patch>,
-    /// Where each panel's id is shown: its face's centre, its edge's midpoint, the
-    /// centre of the middle facet of its ribbon.
+    /// Where each panel's id is shown (see [`Covers`]).
     pub anchors: Vec<DVec3>,
     /// The model has no boundary: its inside is never seen.
     pub closed: bool,
 }
 
-/// Where the `panels` the scheme built from `mesh` sit on it; `islands` lists the faces
-/// of each island panel (`Source::Island(k)`: entry k − 1).
-pub fn panel_surface(mesh: &Mesh, panels: &Panels, islands: &[Vec<u32>]) -> PanelSurface {
-    let island = |k: u32| islands.get(k as usize - 1).map_or(&[][..], Vec::as_slice);
+/// Where the `panels` the scheme built from `mesh` sit on it; `face_groups` lists the
+/// faces of each panel that covers a group of faces (`Covers::Faces(k)`: entry k).
+pub fn panel_surface(mesh: &Mesh, panels: &Panels, face_groups: &[FaceGroup]) -> PanelSurface {
+    let group = |k: u32| face_groups.get(k as usize);
+    let faces = |k: u32| group(k).map_or(&[][..], |g| g.faces.as_slice());
     PanelSurface {
-        patches: patches(mesh, panels, island),
+        patches: patches(mesh, panels, faces),
         anchors: panels
             .iter()
-            .map(|p| match p.source {
-                Source::Island(k) => island_anchor(mesh, island(k)),
-                _ => anchor(mesh, p.source, p.vertices, p.facets.iter().collect()),
+            .map(|p| match p.source.covers {
+                Covers::Faces(k) => group(k).map_or(DVec3::ZERO, |g| g.anchor),
+                covers => anchor(mesh, covers, p.vertices, p.facets.iter().collect()),
             })
             .collect(),
         closed: mesh.edges().all(|e| !mesh.is_boundary_edge(e)),
@@ -52,7 +49,7 @@ pub fn panel_surface(mesh: &Mesh, panels: &Panels, islands: &[Vec<u32>]) -> Pane
 }
 
 /// The surface each panel covers (see the module's doc).
-fn patches<'a>(mesh: &Mesh, panels: &Panels, island: impl Fn(u32) -> &'a [u32]) -> Vec<Patch> {
+fn patches<'a>(mesh: &Mesh, panels: &Panels, group: impl Fn(u32) -> &'a [u32]) -> Vec<Patch> {
     let mut patches = Vec::new();
     let face_patch = |f: FaceId, k: usize| Patch {
         points: mesh.face_positions(f).collect(),
@@ -60,12 +57,12 @@ fn patches<'a>(mesh: &Mesh, panels: &Panels, island: impl Fn(u32) -> &'a [u32]) 
         panel: k,
     };
     for (k, panel) in panels.iter().enumerate() {
-        match panel.source {
-            Source::Face(f) => patches.push(face_patch(FaceId(f), k)),
-            Source::Island(i) => {
-                patches.extend(island(i).iter().map(|&f| face_patch(FaceId(f), k)));
+        match panel.source.covers {
+            Covers::Face(f) => patches.push(face_patch(FaceId(f), k)),
+            Covers::Faces(i) => {
+                patches.extend(group(i).iter().map(|&f| face_patch(FaceId(f), k)));
             }
-            Source::Edge(e) => {
+            Covers::Edge(e) => {
                 let h = EdgeId(e).half_edge();
                 for h in [h, h.twin()] {
                     if let Some(f) = mesh.face(h) {
@@ -81,7 +78,7 @@ fn patches<'a>(mesh: &Mesh, panels: &Panels, island: impl Fn(u32) -> &'a [u32]) 
                     }
                 }
             }
-            Source::Cycle { .. } => {
+            Covers::Itself => {
                 for facet in panel.facets.iter() {
                     let points: Vec<DVec3> =
                         facet.iter().map(|&i| panel.vertices[i as usize]).collect();
@@ -98,9 +95,9 @@ fn patches<'a>(mesh: &Mesh, panels: &Panels, island: impl Fn(u32) -> &'a [u32]) 
     patches
 }
 
-/// Where an island's id goes: the centre of its face nearest the middle of their
-/// centres.
-fn island_anchor(mesh: &Mesh, faces: &[u32]) -> DVec3 {
+/// A place for the id of a group of faces: the centre of its face nearest the middle
+/// of their centres (on the surface, where the middle itself may not be).
+pub fn group_anchor(mesh: &Mesh, faces: &[u32]) -> DVec3 {
     let centres: Vec<DVec3> = faces.iter().map(|&f| mesh.face_centre(FaceId(f))).collect();
     let middle = centres.iter().copied().sum::<DVec3>() / centres.len().max(1) as f64;
     centres
@@ -109,17 +106,17 @@ fn island_anchor(mesh: &Mesh, faces: &[u32]) -> DVec3 {
         .unwrap_or(DVec3::ZERO)
 }
 
-/// Where a panel's id goes: its face's centre, its edge's midpoint, the centre of the
-/// middle facet of its ribbon.
-fn anchor(mesh: &Mesh, source: Source, vertices: &[DVec3], facets: Vec<&[u32]>) -> DVec3 {
-    match source {
-        Source::Face(f) => mesh.face_centre(FaceId(f)),
-        Source::Edge(e) => {
+/// Where a panel's id goes: its face's centre, its edge's midpoint, the centre of its
+/// own middle facet.
+fn anchor(mesh: &Mesh, covers: Covers, vertices: &[DVec3], facets: Vec<&[u32]>) -> DVec3 {
+    match covers {
+        Covers::Face(f) => mesh.face_centre(FaceId(f)),
+        Covers::Edge(e) => {
             let (a, b) = mesh.edge_vertices(EdgeId(e));
             0.5 * (mesh.position(a) + mesh.position(b))
         }
-        // Islands are placed by `island_anchor`.
-        Source::Cycle { .. } | Source::Island(_) => {
+        // A group of faces is placed where its scheme said.
+        Covers::Itself | Covers::Faces(_) => {
             let Some(facet) = facets.get(facets.len() / 2) else {
                 return DVec3::ZERO;
             };

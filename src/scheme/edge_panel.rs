@@ -95,7 +95,7 @@ impl EdgeOptions {
 
 /// The id printed for an edge panel.
 pub fn panel_id(e: EdgeId) -> Name {
-    Name::Edge(e.0)
+    Name::edge(e.0)
 }
 
 /// One face's share of the edge panels, in 3D: the band, each band edge's flap outline,
@@ -579,7 +579,7 @@ pub fn unfastened(mesh: &Mesh, faces: &[FaceFlaps]) -> Vec<super::ConnectionName
         .flat_map(|f| &f.bare)
         .map(|&h| super::ConnectionName {
             panels: [panel_id(mesh.prev(h).edge()), panel_id(h.edge())],
-            at: Name::Vertex(mesh.origin(h).0),
+            at: Name::vertex(mesh.origin(h).0),
         })
         .collect()
 }
@@ -768,7 +768,7 @@ fn edge_panel(
         flap_labels(mesh, other, g, h.twin(), k2, facet, options, &mut labels);
     }
 
-    Panel::new(Source::Edge(e.0), vertices, facets, holes, labels)
+    Panel::new(Source::edge(e.0), vertices, facets, holes, labels)
 }
 
 /// Labels [`flap_labels`] puts on a flap.
@@ -811,7 +811,7 @@ fn flap_labels(
     }
     for (_, c, vertex) in ends {
         labels.push(Label {
-            text: Name::Vertex(vertex.0),
+            text: Name::vertex(vertex.0),
             anchor: part.corner_label(c),
             direction: along,
             height: options.panel.label_height,
@@ -822,7 +822,7 @@ fn flap_labels(
         });
     }
     labels.push(Label {
-        text: Name::Face(face.0),
+        text: Name::face(face.0),
         anchor: middle,
         direction: along,
         height: options.panel.label_height,

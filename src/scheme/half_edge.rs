@@ -203,7 +203,7 @@ impl Configured for HalfEdgeOptions {
 
 /// The id printed for a face panel.
 pub fn panel_id(f: FaceId) -> Name {
-    Name::Face(f.0)
+    Name::face(f.0)
 }
 
 /// Builds the face panels of a mesh whose faces are planar and star-shaped from their
@@ -265,8 +265,8 @@ pub fn panels(mesh: &Mesh, options: &HalfEdgeOptions) -> SchemeOutput {
         .filter_map(|t| {
             let neighbour = mesh.face(t.owner.twin())?;
             Some(super::ConnectionName {
-                panels: [Name::Face(mesh.face(t.owner)?.0), Name::Face(neighbour.0)],
-                at: Name::Edge(t.owner.edge().0),
+                panels: [Name::face(mesh.face(t.owner)?.0), Name::face(neighbour.0)],
+                at: Name::edge(t.owner.edge().0),
             })
         })
         .collect();
@@ -417,7 +417,7 @@ fn face_panel(
         });
     }
 
-    Panel::new(Source::Face(f.0), vertices, facets, holes, labels)
+    Panel::new(Source::face(f.0), vertices, facets, holes, labels)
 }
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or

@@ -22,7 +22,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use crate::mesh::{FaceId, Mesh};
-use crate::panel::{Name, Panels};
+use crate::panel::{FaceGroup, Name, Panels};
 use crate::record::{round4, Params};
 
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
@@ -69,6 +69,11 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError>;
     /// Its own options as used, for the manifest's `scheme.params` (lengths in mm).
     fn params(&self) -> Params;
+    /// The least fold (radians) scored on its panels: flatter hinges are left as they
+    /// are. Only exactly flat hinges unless the scheme says otherwise.
+    fn least_scored_fold(&self) -> f64 {
+        crate::flatten::LEAST_SCORED_FOLD
+    }
 }
 
 /// The concrete options behind a [`Configured`], for callers that know their type
@@ -339,6 +344,11 @@ impl ConfiguredScheme {
         self.options.build(mesh)
     }
 
+    /// The least fold (radians) scored on its panels.
+    pub fn least_scored_fold(&self) -> f64 {
+        self.options.least_scored_fold()
+    }
+
     /// The manifest's `scheme.params`: the shared options, then the scheme's own.
     pub fn params(&self) -> Params {
         let panel = self.panel();
@@ -383,12 +393,9 @@ pub struct SchemeOutput {
     /// Connections that hold no fastener hole although holes were asked for (no room
     /// for one), in a deterministic order.
     pub unfastened: Vec<ConnectionName>,
-    /// The mesh faces of each island panel (`Source::Island(k)` is entry k − 1), each
-    /// list in increasing order.
-    pub islands: Vec<Vec<u32>>,
-    /// Hinges flatter than this angle (radians) are not scored; `None`: only exactly
-    /// flat ones are left unscored.
-    pub flat_fold: Option<f64>,
+    /// The mesh faces of each panel that covers a group of faces (`Covers::Faces(k)`
+    /// is entry k), each list in increasing order.
+    pub face_groups: Vec<FaceGroup>,
 }
 
 /// A build where more than this fraction of the connections holds no fastener hole

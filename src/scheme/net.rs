@@ -29,7 +29,10 @@ use super::half_edge::{make_tab, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use crate::panel::{FoldKind, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::panel::surface::group_anchor;
+use crate::panel::{
+    Covers, FaceGroup, FoldKind, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source,
+};
 use crate::plane::{convex_hull, fits_rotated};
 use crate::record::{round4, Params};
 use crate::units::fmt_path_length;
@@ -54,6 +57,22 @@ const SMALL_ISLAND: usize = 6;
 
 /// Tab heights tried, as fractions of `--tab-height`, before a tab is left out.
 const TAB_STEPS: [f64; 3] = [1.0, 0.5, 0.25];
+
+/// Islands: `N4`, numbered from 1; the manifest lists an island's faces.
+pub static ISLAND: IdKind = IdKind {
+    letter: "N",
+    legend: "net island",
+    noun: "island",
+    part_noun: "",
+};
+
+/// Match numbers: `17`, the same on both sides of a cut, so its two sides are found.
+pub static MATCH: IdKind = IdKind {
+    letter: "",
+    legend: "a bare number marks the two sides of one cut",
+    noun: "match",
+    part_noun: "",
+};
 
 /// The net scheme: islands of faces joined along folds, glue tabs on the cuts.
 pub struct Net;
@@ -178,6 +197,10 @@ impl Configured for NetOptions {
         params.push("flat_fold_deg", round4(self.flat_fold.to_degrees()));
         params.push("island_spread", self.island_spread);
         params
+    }
+
+    fn least_scored_fold(&self) -> f64 {
+        self.flat_fold
     }
 }
 
@@ -1042,10 +1065,10 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
                 let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
                 Some(ConnectionName {
                     panels: [
-                        Name::Island(number[f.index()]),
-                        Name::Island(number[g.index()]),
+                        Name::new(&ISLAND, number[f.index()]),
+                        Name::new(&ISLAND, number[g.index()]),
                     ],
-                    at: Name::Edge(e.0),
+                    at: Name::edge(e.0),
                 })
             })
             .collect()
@@ -1061,8 +1084,13 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         report: summary.report(),
         manifest: summary.manifest(),
         unfastened,
-        islands: members,
-        flat_fold: Some(options.flat_fold),
+        face_groups: members
+            .into_iter()
+            .map(|faces| FaceGroup {
+                anchor: group_anchor(mesh, &faces),
+                faces,
+            })
+            .collect(),
     }
 }
 
@@ -1115,7 +1143,7 @@ fn island_panel(
                 if !owns_tab {
                     let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
                     labels.push(Label {
-                        text: Name::Match(m),
+                        text: Name::new(&MATCH, m),
                         anchor: 0.5 * (a + b),
                         direction: (b - a).normalize(),
                         height,
@@ -1142,7 +1170,7 @@ fn island_panel(
         facets.push(facet);
         let (a, b) = (placed.base[0], placed.base[1]);
         labels.push(Label {
-            text: Name::Match(match_of[&e.0]),
+            text: Name::new(&MATCH, match_of[&e.0]),
             anchor: 0.5 * (a + b),
             direction: (a - b).normalize(),
             height,
@@ -1189,7 +1217,7 @@ fn island_panel(
         })
         .unwrap_or(0);
     labels.push(Label {
-        text: Name::Island(number),
+        text: Name::new(&ISLAND, number),
         anchor: mesh.face_centre(FaceId(label_face)),
         direction: (corners[(longest + 1) % corners.len()] - corners[longest]).normalize(),
         height,
@@ -1198,7 +1226,11 @@ fn island_panel(
         on_edge: false,
         slide: 0.0,
     });
-    Panel::new(Source::Island(number), vertices, facets, holes, labels)
+    let source = Source {
+        id: Name::new(&ISLAND, number),
+        covers: Covers::Faces(number - 1),
+    };
+    Panel::new(source, vertices, facets, holes, labels)
 }
 
 /// The face that shows an island's id: the largest among those whose centre lies in

@@ -31,7 +31,9 @@ use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
-use crate::panel::{FacetFrame, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::panel::{
+    Covers, FacetFrame, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source,
+};
 use crate::plane::{
     clip_convex, contains, convex_hull, counter_clockwise, distance_to_border, fits_rotated,
     segment_distance, smallest_box,
@@ -343,17 +345,22 @@ fn cycle_manifest(cycles: &[CycleSummary]) -> Params {
     manifest
 }
 
+/// Woven cycles: `C3`, and their segments, `C3.2` (both numbered from 1).
+pub static CYCLE: IdKind = IdKind {
+    letter: "C",
+    legend: "woven cycle (C3.2: its segment 2)",
+    noun: "cycle",
+    part_noun: "segment",
+};
+
 /// The printed id of a cycle.
 pub fn cycle_id(cycle: u32) -> Name {
-    Name::Cycle(cycle + 1)
+    Name::new(&CYCLE, cycle + 1)
 }
 
 /// The printed id of a segment (both 1-based).
 pub fn segment_id(cycle: u32, segment: usize) -> Name {
-    Name::Segment {
-        cycle: cycle + 1,
-        segment: segment as u32 + 1,
-    }
+    Name::with_part(&CYCLE, cycle + 1, segment as u32 + 1)
 }
 
 /// The face bands' geometry the strands are cut from.
@@ -963,7 +970,7 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
                         segment_id(ribbon.cycle, partners[0]),
                         segment_id(ribbon.cycle, s),
                     ],
-                    at: Name::Vertex(mesh.dest(corner).0),
+                    at: Name::vertex(mesh.dest(corner).0),
                 });
             } else if at_start < wanted {
                 joints_short += 1;
@@ -1111,9 +1118,9 @@ fn segment_panel(
     }
     (
         Panel::new(
-            Source::Cycle {
-                cycle: ribbon.cycle + 1,
-                segment: segment as u32 + 1,
+            Source {
+                id: segment_id(ribbon.cycle, segment),
+                covers: Covers::Itself,
             },
             vertices,
             facets,

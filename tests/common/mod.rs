@@ -25,6 +25,7 @@
 pub mod build;
 pub mod corpus;
 pub mod dxf_read;
+pub mod map;
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
