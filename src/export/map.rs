@@ -120,55 +120,110 @@ pub struct MapInput<'a> {
 /// The assembly map as an SVG document, on a page of the sheet's size.
 pub fn assembly_map(input: &MapInput) -> String {
     let patches = &input.surface.patches;
-    let anchors = &input.surface.anchors;
-    let sheet_of: Vec<usize> = {
-        let mut s = vec![0; input.panels.len()];
-        for p in &input.layout.placements {
-            s[p.part] = p.sheet;
-        }
-        s
-    };
-    let closed = input.surface.closed;
+    let mut sheet_of = vec![0; input.panels.len()];
+    for p in &input.layout.placements {
+        sheet_of[p.part] = p.sheet;
+    }
     let mut panel_patches = vec![Vec::new(); input.panels.len()];
     for (i, patch) in patches.iter().enumerate() {
         panel_patches[patch.panel].push(i);
     }
-
-    let (page_w, page_h) = (input.layout.sheet.width, input.layout.sheet.height);
-    let area_w = page_w - 2.0 * BORDER;
-    let area_h = page_h - 2.0 * BORDER - TITLE - LEGEND;
-    // Extents of each view in model mm.
     let views = views();
+    // Extents of each view in model mm.
     let extents: Vec<(DVec2, DVec2)> = views
         .iter()
         .map(|v| bounds(patches.iter().flat_map(|p| &p.points), v))
         .collect();
-    // The grid of views (columns x rows) that draws the model largest, one scale for
-    // all views so they compare.
-    let (cols, rows, scale) = [(2usize, 3usize), (3, 2), (1, 6), (6, 1)]
-        .into_iter()
-        .map(|(c, r)| {
-            let (cw, ch) = (area_w / c as f64, area_h / r as f64 - 2.0 * CAPTION);
-            let s = extents
-                .iter()
-                .map(|(lo, hi)| {
-                    let size = (*hi - *lo).max(DVec2::splat(1e-9));
-                    (0.92 * cw / size.x).min(0.92 * ch / size.y)
-                })
-                .fold(f64::INFINITY, f64::min);
-            (c, r, s)
-        })
-        .max_by(|a, b| a.2.total_cmp(&b.2))
-        .unwrap_or((2, 3, 1.0));
-    let scale = if scale.is_finite() && scale > 0.0 {
-        scale
-    } else {
-        1.0
+    let grid = Grid::largest(input, &extents);
+    let map = MapContext {
+        input,
+        sheet_of,
+        panel_patches,
+        text: text_height(input, grid.scale),
+        grid,
     };
-    let text = text_height(input, scale);
-    let (cell_w, cell_h) = (area_w / cols as f64, area_h / rows as f64);
 
     let mut out = String::new();
+    page_head(&mut out, input);
+    let mut named = vec![false; input.panels.len()];
+    for (k, view) in views.iter().enumerate() {
+        draw_view(&mut out, &map, k, view, extents[k], &mut named);
+    }
+    let (_, page_h) = page_size(input);
+    legend(
+        &mut out,
+        input,
+        page_h,
+        named.iter().filter(|&&n| n).count(),
+    );
+    out.push_str("</svg>\n");
+    out
+}
+
+/// What every view of a map is drawn with.
+struct MapContext<'a> {
+    input: &'a MapInput<'a>,
+    /// Each panel's sheet (its tint).
+    sheet_of: Vec<usize>,
+    /// Each panel's patches, as indices into the surface's.
+    panel_patches: Vec<Vec<usize>>,
+    grid: Grid,
+    /// The ids' text height (mm).
+    text: f64,
+}
+
+/// The page's grid of views and the one scale they share.
+struct Grid {
+    cols: usize,
+    /// Page mm per model mm.
+    scale: f64,
+    cell_w: f64,
+    cell_h: f64,
+}
+
+impl Grid {
+    /// The grid of views (columns x rows) that draws the model largest, one scale for
+    /// all views so they compare.
+    fn largest(input: &MapInput, extents: &[(DVec2, DVec2)]) -> Grid {
+        let (page_w, page_h) = page_size(input);
+        let area_w = page_w - 2.0 * BORDER;
+        let area_h = page_h - 2.0 * BORDER - TITLE - LEGEND;
+        let (cols, rows, scale) = [(2usize, 3usize), (3, 2), (1, 6), (6, 1)]
+            .into_iter()
+            .map(|(c, r)| {
+                let (cw, ch) = (area_w / c as f64, area_h / r as f64 - 2.0 * CAPTION);
+                let s = extents
+                    .iter()
+                    .map(|(lo, hi)| {
+                        let size = (*hi - *lo).max(DVec2::splat(1e-9));
+                        (0.92 * cw / size.x).min(0.92 * ch / size.y)
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                (c, r, s)
+            })
+            .max_by(|a, b| a.2.total_cmp(&b.2))
+            .unwrap_or((2, 3, 1.0));
+        Grid {
+            cols,
+            scale: if scale.is_finite() && scale > 0.0 {
+                scale
+            } else {
+                1.0
+            },
+            cell_w: area_w / cols as f64,
+            cell_h: area_h / rows as f64,
+        }
+    }
+}
+
+/// The page: the sheet's width and height (mm).
+fn page_size(input: &MapInput) -> (f64, f64) {
+    (input.layout.sheet.width, input.layout.sheet.height)
+}
+
+/// The SVG header, the white page and the title.
+fn page_head(out: &mut String, input: &MapInput) {
+    let (page_w, page_h) = page_size(input);
     let _ = writeln!(
         out,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{w}mm\" height=\"{h}mm\" viewBox=\"0 0 {w} {h}\" font-family=\"Helvetica, Arial, sans-serif\">",
@@ -190,119 +245,159 @@ pub fn assembly_map(input: &MapInput) -> String {
         input.panels.len(),
         input.layout.sheets
     );
-    let mut named = vec![false; input.panels.len()];
-    for (k, view) in views.iter().enumerate() {
-        let (col, row) = (k % cols, k / cols);
-        let cell_lo = DVec2::new(
-            BORDER + col as f64 * cell_w,
-            BORDER + TITLE + row as f64 * cell_h,
-        );
-        let (lo, hi) = extents[k];
-        let centre = 0.5 * (lo + hi);
-        // Page point of a model point: the view's (right, up) scaled, y down.
-        let origin = cell_lo + DVec2::new(0.5 * cell_w, 0.5 * (cell_h + CAPTION))
-            - scale * DVec2::new(centre.x, -centre.y);
-        let to_page = |p: DVec3| {
-            let q = project(p, view);
-            origin + scale * DVec2::new(q.x, -q.y)
-        };
-        let _ = writeln!(
-            out,
-            "<g id=\"view-{name}\" data-view=\"{name}\" data-toward=\"{}\" data-up=\"{}\" data-scale=\"{}\" data-origin=\"{} {}\">",
-            vec3(view.toward),
-            vec3(view.up),
-            scale,
-            origin.x,
-            origin.y,
-            name = view.name
-        );
-        let _ = writeln!(
-            out,
-            "<text x=\"{}\" y=\"{}\" font-size=\"4.5\">{} (from {}, turned {:.0}° toward {})</text>",
-            fmt_mm(cell_lo.x + 2.0),
-            fmt_mm(cell_lo.y + 5.0),
-            view.name,
-            view.axis,
-            TILT.atan().to_degrees(),
-            view.turn
-        );
-        // Far to near; back faces of a closed model are never seen.
-        let mut order: Vec<(f64, usize)> = patches
-            .iter()
-            .enumerate()
-            .filter(|(_, p)| !closed || p.normal.dot(view.toward) > 1e-9)
-            .map(|(i, p)| {
-                let depth = p.points.iter().map(|q| q.dot(view.toward)).sum::<f64>()
-                    / p.points.len() as f64;
-                (depth, i)
-            })
-            .collect();
-        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for &(_, i) in &order {
-            let patch = &patches[i];
-            let facing = patch.normal.dot(view.toward);
-            let fill = sheet_colour(sheet_of[patch.panel], facing);
-            let mut d = String::new();
-            for (j, &p) in patch.points.iter().enumerate() {
-                let q = to_page(p);
-                let _ = write!(
-                    d,
-                    "{}{} {}",
-                    if j == 0 { "M" } else { " L" },
-                    fmt_mm(q.x),
-                    fmt_mm(q.y)
-                );
-            }
-            let _ = writeln!(
-                out,
-                "<path d=\"{d} Z\" fill=\"{fill}\" stroke=\"#606060\" stroke-width=\"0.05\"/>"
-            );
-        }
-        // Which panel is seen at each raster cell.
-        let raster = Raster::new(cell_lo, DVec2::new(cell_w, cell_h));
-        let owners = raster.owners(patches, &order, view, &to_page);
-        let mut seen = vec![0usize; input.panels.len()];
-        for &o in owners.iter().flatten() {
-            seen[o as usize] += 1;
-        }
-        // Panels not yet named in an earlier view first, then the best seen.
-        let mut candidates: Vec<usize> = (0..input.panels.len()).filter(|&p| seen[p] > 0).collect();
-        candidates.sort_by(|&a, &b| (named[a], seen[b], a).cmp(&(named[b], seen[a], b)));
-        let mut placed = Placed::new(text * 4.0);
-        for p in candidates {
-            let id = input.panels.get(p).source.name().to_string();
-            let half = 0.5 * DVec2::new(CHAR_WIDTH * text * id.len() as f64, text);
-            // The anchor, or where it is crowded, a point nearer the middle of one of
-            // the panel's patches: always on the panel itself as seen.
-            let spot = spots(anchors[p], &panel_patches[p], patches)
-                .map(to_page)
-                .find(|&at| {
-                    raster.owner_at(&owners, at) == Some(p as u32)
-                        && placed.try_add(at - half, at + half, 0.25 * text)
-                });
-            let Some(at) = spot else {
-                continue;
-            };
-            named[p] = true;
-            let _ = writeln!(
-                out,
-                "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" dy=\"0.35em\" stroke=\"#FFFFFF\" stroke-width=\"{}\" paint-order=\"stroke\">{id}</text>",
-                fmt_mm(at.x),
-                fmt_mm(at.y),
-                fmt_mm(text),
-                fmt_mm(0.25 * text)
-            );
-        }
-        out.push_str("</g>\n");
-    }
-    legend(
-        &mut out,
-        input,
-        page_h,
-        named.iter().filter(|&&n| n).count(),
+}
+
+/// View `k` in its cell: its group (with the projection, for readers that map page
+/// points back to the model), caption, patches far to near and the panel ids where
+/// their panels are seen; `named` marks the panels named so far.
+fn draw_view(
+    out: &mut String,
+    map: &MapContext,
+    k: usize,
+    view: &View,
+    (lo, hi): (DVec2, DVec2),
+    named: &mut [bool],
+) {
+    let grid = &map.grid;
+    let (col, row) = (k % grid.cols, k / grid.cols);
+    let cell_lo = DVec2::new(
+        BORDER + col as f64 * grid.cell_w,
+        BORDER + TITLE + row as f64 * grid.cell_h,
     );
-    out.push_str("</svg>\n");
-    out
+    let centre = 0.5 * (lo + hi);
+    // Page point of a model point: the view's (right, up) scaled, y down.
+    let scale = grid.scale;
+    let origin = cell_lo + DVec2::new(0.5 * grid.cell_w, 0.5 * (grid.cell_h + CAPTION))
+        - scale * DVec2::new(centre.x, -centre.y);
+    let to_page = |p: DVec3| {
+        let q = project(p, view);
+        origin + scale * DVec2::new(q.x, -q.y)
+    };
+    let _ = writeln!(
+        out,
+        "<g id=\"view-{name}\" data-view=\"{name}\" data-toward=\"{}\" data-up=\"{}\" data-scale=\"{}\" data-origin=\"{} {}\">",
+        vec3(view.toward),
+        vec3(view.up),
+        scale,
+        origin.x,
+        origin.y,
+        name = view.name
+    );
+    let _ = writeln!(
+        out,
+        "<text x=\"{}\" y=\"{}\" font-size=\"4.5\">{} (from {}, turned {:.0}° toward {})</text>",
+        fmt_mm(cell_lo.x + 2.0),
+        fmt_mm(cell_lo.y + 5.0),
+        view.name,
+        view.axis,
+        TILT.atan().to_degrees(),
+        view.turn
+    );
+    let order = far_to_near(map.input.surface, view);
+    draw_patches(out, map, &order, view, &to_page);
+    let raster = Raster::new(cell_lo, DVec2::new(grid.cell_w, grid.cell_h));
+    let owners = raster.owners(&map.input.surface.patches, &order, view, &to_page);
+    let seen = SeenPanels {
+        raster: &raster,
+        owners: &owners,
+        to_page: &to_page,
+    };
+    name_panels(out, map, &seen, named);
+    out.push_str("</g>\n");
+}
+
+/// The patches a view may see, far to near (depth, index); back faces of a closed
+/// model are never seen.
+fn far_to_near(surface: &PanelSurface, view: &View) -> Vec<(f64, usize)> {
+    let mut order: Vec<(f64, usize)> = surface
+        .patches
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| !surface.closed || p.normal.dot(view.toward) > 1e-9)
+        .map(|(i, p)| {
+            let depth =
+                p.points.iter().map(|q| q.dot(view.toward)).sum::<f64>() / p.points.len() as f64;
+            (depth, i)
+        })
+        .collect();
+    order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    order
+}
+
+/// Each patch in `order` as a path tinted by its panel's sheet, shaded by how much it
+/// faces the viewer.
+fn draw_patches(
+    out: &mut String,
+    map: &MapContext,
+    order: &[(f64, usize)],
+    view: &View,
+    to_page: &dyn Fn(DVec3) -> DVec2,
+) {
+    for &(_, i) in order {
+        let patch = &map.input.surface.patches[i];
+        let facing = patch.normal.dot(view.toward);
+        let fill = sheet_colour(map.sheet_of[patch.panel], facing);
+        let mut d = String::new();
+        for (j, &p) in patch.points.iter().enumerate() {
+            let q = to_page(p);
+            let _ = write!(
+                d,
+                "{}{} {}",
+                if j == 0 { "M" } else { " L" },
+                fmt_mm(q.x),
+                fmt_mm(q.y)
+            );
+        }
+        let _ = writeln!(
+            out,
+            "<path d=\"{d} Z\" fill=\"{fill}\" stroke=\"#606060\" stroke-width=\"0.05\"/>"
+        );
+    }
+}
+
+/// Which panel a view shows where, and where a model point lands on the page.
+struct SeenPanels<'a> {
+    raster: &'a Raster,
+    owners: &'a [Option<u32>],
+    to_page: &'a dyn Fn(DVec3) -> DVec2,
+}
+
+/// Writes the id of every panel the view shows, where its own panel is seen and no
+/// other id is: panels not yet named in an earlier view first, then the best seen.
+fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mut [bool]) {
+    let (panels, patches) = (map.input.panels, &map.input.surface.patches);
+    let text = map.text;
+    let mut cells = vec![0usize; panels.len()];
+    for &o in seen.owners.iter().flatten() {
+        cells[o as usize] += 1;
+    }
+    let mut candidates: Vec<usize> = (0..panels.len()).filter(|&p| cells[p] > 0).collect();
+    candidates.sort_by(|&a, &b| (named[a], cells[b], a).cmp(&(named[b], cells[a], b)));
+    let mut placed = Placed::new(text * 4.0);
+    for p in candidates {
+        let id = panels.get(p).source.name().to_string();
+        let half = 0.5 * DVec2::new(CHAR_WIDTH * text * id.len() as f64, text);
+        // The anchor, or where it is crowded, a point nearer the middle of one of
+        // the panel's patches: always on the panel itself as seen.
+        let spot = spots(map.input.surface.anchors[p], &map.panel_patches[p], patches)
+            .map(seen.to_page)
+            .find(|&at| {
+                seen.raster.owner_at(seen.owners, at) == Some(p as u32)
+                    && placed.try_add(at - half, at + half, 0.25 * text)
+            });
+        let Some(at) = spot else {
+            continue;
+        };
+        named[p] = true;
+        let _ = writeln!(
+            out,
+            "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" dy=\"0.35em\" stroke=\"#FFFFFF\" stroke-width=\"{}\" paint-order=\"stroke\">{id}</text>",
+            fmt_mm(at.x),
+            fmt_mm(at.y),
+            fmt_mm(text),
+            fmt_mm(0.25 * text)
+        );
+    }
 }
 
 /// Where a panel's id may go, best first: its anchor, then points a third and two

@@ -309,7 +309,6 @@ fn face_panel(
     let mut band_facet: Vec<u32> = Vec::with_capacity(n + 4);
     let mut extra_facets: Vec<Vec<u32>> = Vec::new();
     let mut holes = Vec::new();
-    let mut labels = Vec::new();
     // Facet 0 is the band; tab facets follow (indices known once pushed).
     let tab_of = |h: HalfedgeId| tabs.of_edge(h.edge());
     let mut pending_tabs: Vec<(&Tab, u32, u32)> = Vec::new();
@@ -376,8 +375,23 @@ fn face_panel(
         }
     }
 
-    // Labels: the panel id at the centre, along the longest band edge; the partner id
-    // inside every interior edge.
+    let labels = face_labels(mesh, f, band, tabs, options);
+    Panel::new(Source::face(f.0), vertices, facets, holes, labels)
+}
+
+/// The labels of face `f`'s panel: its id at the centre, along the longest band edge;
+/// the partner id inside every interior edge (with tabs, only where a tab joins).
+fn face_labels(
+    mesh: &Mesh,
+    f: FaceId,
+    band: &[DVec3],
+    tabs: &Tabs,
+    options: &HalfEdgeOptions,
+) -> Vec<Label> {
+    let half_edges: Vec<HalfedgeId> = mesh.face_half_edges(f).collect();
+    let n = half_edges.len();
+    let tab_of = |h: HalfedgeId| tabs.of_edge(h.edge());
+    let mut labels = Vec::with_capacity(n + 1);
     let longest = (0..n)
         .max_by(|&i, &j| {
             let li = band[i].distance(band[(i + 1) % n]);
@@ -416,8 +430,7 @@ fn face_panel(
             slide: 0.3 * a.distance(b),
         });
     }
-
-    Panel::new(Source::face(f.0), vertices, facets, holes, labels)
+    labels
 }
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or

@@ -31,7 +31,7 @@ use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::surface::group_anchor;
 use crate::panel::{
-    Covers, FaceGroup, FoldKind, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source,
+    Covers, FaceGroup, FoldKind, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Source,
 };
 use crate::plane::{convex_hull, fits_rotated};
 use crate::record::{round4, Params};
@@ -948,49 +948,11 @@ fn place_tabs(
 
 /// Builds the islands of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
-    let lengths = mesh.sorted_edge_lengths();
-    let cell = 2.0
-        * lengths
-            .get(lengths.len() / 2)
-            .copied()
-            .unwrap_or(1.0)
-            .max(1e-3);
-    let mut islands = Islands::new(mesh, cell);
-
-    // Flattest edges first; the sharp ones are left to be cut.
-    let mut order: Vec<(f64, EdgeId)> = mesh
-        .edges()
-        .filter_map(|e| fold_angle(mesh, e).map(|a| (a, e)))
-        .collect();
-    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1 .0.cmp(&y.1 .0)));
-    let component_faces: Vec<usize> = {
-        let (component, count) = mesh.face_components();
-        let mut sizes = vec![0usize; count];
-        for &c in &component {
-            sizes[c as usize] += 1;
-        }
-        component.iter().map(|&c| sizes[c as usize]).collect()
-    };
-    let mut rules = JoinRules {
-        options,
-        scale: lengths.last().copied().unwrap_or(1.0),
-        spread: options.island_spread,
-        small: usize::MAX,
-        component_faces: &component_faces,
-    };
-    for &(_, e) in &order {
-        islands.try_join(mesh, e, &rules);
-    }
-    // Then small islands join a neighbour whatever its shape.
-    rules.spread = f64::INFINITY;
-    rules.small = SMALL_ISLAND;
-    for &(_, e) in &order {
-        islands.try_join(mesh, e, &rules);
-    }
+    let (islands, order) = grow_islands(mesh, options);
     let cuts: Vec<EdgeId> = order
         .iter()
-        .map(|&(_, e)| e)
         .filter(|e| !islands.fold[e.index()])
+        .copied()
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
@@ -1016,74 +978,36 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
             facet_of[f as usize] = i as u32;
         }
     }
-    let match_of: HashMap<u32, u32> = cuts
-        .iter()
-        .enumerate()
-        .map(|(k, e)| (e.0, k as u32 + 1))
-        .collect();
-
+    let net = BuiltNet {
+        mesh,
+        islands: &islands,
+        tabs: &tabs,
+        match_of: cuts
+            .iter()
+            .enumerate()
+            .map(|(k, e)| (e.0, k as u32 + 1))
+            .collect(),
+        facet_of,
+        options,
+    };
     let built: Vec<Panel> = members
         .iter()
         .enumerate()
-        .map(|(k, faces)| {
-            island_panel(
-                mesh,
-                k as u32 + 1,
-                faces,
-                &islands,
-                &tabs,
-                &match_of,
-                &facet_of,
-                options,
-            )
-        })
+        .map(|(k, faces)| island_panel(&net, k as u32 + 1, faces))
         .collect();
-    let panels: Panels = built.into_iter().collect();
 
     let tab_count = tabs.iter().flatten().count();
     let shortened = tabs.iter().flatten().filter(|t| t.shortened).count();
-    let mut notes = Vec::new();
-    if tab_count < cuts.len() {
-        notes.push(format!(
-            "{} of {} cut edges have no tab: no room for one beside their island's other faces (glue them edge to edge, or try a smaller --tab-height)",
-            cuts.len() - tab_count,
-            cuts.len()
-        ));
-    }
-    if shortened > 0 {
-        notes.push(format!(
-            "{shortened} tabs were shortened to stay inside their neighbour face and clear of their island"
-        ));
-    }
-    let unfastened: Vec<ConnectionName> = if options.panel.holes == 0 {
-        Vec::new()
-    } else {
-        cuts.iter()
-            .filter(|e| tabs[e.index()].as_ref().is_none_or(|t| t.holes.is_empty()))
-            .filter_map(|&e| {
-                let h = e.half_edge();
-                let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
-                Some(ConnectionName {
-                    panels: [
-                        Name::new(&ISLAND, number[f.index()]),
-                        Name::new(&ISLAND, number[g.index()]),
-                    ],
-                    at: Name::edge(e.0),
-                })
-            })
-            .collect()
-    };
-
     let summary = Summary::of(
         mesh, &islands, &members, &cuts, tab_count, shortened, options,
     );
     SchemeOutput {
-        panels,
+        panels: built.into_iter().collect(),
         connections: cuts.len(),
-        notes,
+        notes: tab_notes(cuts.len(), tab_count, shortened),
         report: summary.report(),
         manifest: summary.manifest(),
-        unfastened,
+        unfastened: unfastened(mesh, &cuts, &tabs, &number, options),
         face_groups: members
             .into_iter()
             .map(|faces| FaceGroup {
@@ -1094,120 +1018,243 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
     }
 }
 
+/// Joins faces into islands along the flattest edges first, under the join rules,
+/// then lets small islands join a neighbour whatever its shape; also the interior
+/// edges in that order (the sharp ones, left to be cut, last).
+fn grow_islands(mesh: &Mesh, options: &NetOptions) -> (Islands, Vec<EdgeId>) {
+    let lengths = mesh.sorted_edge_lengths();
+    let cell = 2.0
+        * lengths
+            .get(lengths.len() / 2)
+            .copied()
+            .unwrap_or(1.0)
+            .max(1e-3);
+    let mut islands = Islands::new(mesh, cell);
+    let mut order: Vec<(f64, EdgeId)> = mesh
+        .edges()
+        .filter_map(|e| fold_angle(mesh, e).map(|a| (a, e)))
+        .collect();
+    order.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1 .0.cmp(&y.1 .0)));
+    let component_faces: Vec<usize> = {
+        let (component, count) = mesh.face_components();
+        let mut sizes = vec![0usize; count];
+        for &c in &component {
+            sizes[c as usize] += 1;
+        }
+        component.iter().map(|&c| sizes[c as usize]).collect()
+    };
+    let mut rules = JoinRules {
+        options,
+        scale: lengths.last().copied().unwrap_or(1.0),
+        spread: options.island_spread,
+        small: usize::MAX,
+        component_faces: &component_faces,
+    };
+    for &(_, e) in &order {
+        islands.try_join(mesh, e, &rules);
+    }
+    rules.spread = f64::INFINITY;
+    rules.small = SMALL_ISLAND;
+    for &(_, e) in &order {
+        islands.try_join(mesh, e, &rules);
+    }
+    (islands, order.into_iter().map(|(_, e)| e).collect())
+}
+
+/// The report's notes on cut edges left without a tab and tabs shortened.
+fn tab_notes(cuts: usize, tabs: usize, shortened: usize) -> Vec<String> {
+    let mut notes = Vec::new();
+    if tabs < cuts {
+        notes.push(format!(
+            "{} of {cuts} cut edges have no tab: no room for one beside their island's other faces (glue them edge to edge, or try a smaller --tab-height)",
+            cuts - tabs
+        ));
+    }
+    if shortened > 0 {
+        notes.push(format!(
+            "{shortened} tabs were shortened to stay inside their neighbour face and clear of their island"
+        ));
+    }
+    notes
+}
+
+/// The cuts whose tab holds no fastener hole although holes were asked for, named by
+/// their two islands (`number` of each face) and the edge.
+fn unfastened(
+    mesh: &Mesh,
+    cuts: &[EdgeId],
+    tabs: &[Option<Tab>],
+    number: &[u32],
+    options: &NetOptions,
+) -> Vec<ConnectionName> {
+    if options.panel.holes == 0 {
+        return Vec::new();
+    }
+    cuts.iter()
+        .filter(|e| tabs[e.index()].as_ref().is_none_or(|t| t.holes.is_empty()))
+        .filter_map(|&e| {
+            let h = e.half_edge();
+            let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
+            Some(ConnectionName {
+                panels: [
+                    Name::new(&ISLAND, number[f.index()]),
+                    Name::new(&ISLAND, number[g.index()]),
+                ],
+                at: Name::edge(e.0),
+            })
+        })
+        .collect()
+}
+
+/// What every island's panel is built from.
+struct BuiltNet<'a> {
+    mesh: &'a Mesh,
+    islands: &'a Islands,
+    /// The tab of each cut edge, where one fits.
+    tabs: &'a [Option<Tab>],
+    /// Each cut edge's match number (from 1).
+    match_of: HashMap<u32, u32>,
+    /// Each face's facet in its island's panel.
+    facet_of: Vec<u32>,
+    options: &'a NetOptions,
+}
+
+/// A panel under construction: corners, facets, holes and labels.
+#[derive(Default)]
+struct PanelParts {
+    vertices: Vec<DVec3>,
+    facets: Loops,
+    holes: Vec<Hole>,
+    labels: Vec<Label>,
+}
+
 /// Builds island `number`'s panel: its faces (facets in face order, corners shared
 /// along folds), then the tabs its faces own; the island id on a central face, match
 /// numbers at every cut edge on both sides.
-#[allow(clippy::too_many_arguments)]
-fn island_panel(
-    mesh: &Mesh,
-    number: u32,
-    faces: &[u32],
-    islands: &Islands,
-    tabs: &[Option<Tab>],
-    match_of: &HashMap<u32, u32>,
-    facet_of: &[u32],
-    options: &NetOptions,
-) -> Panel {
-    let height = options.panel.label_height;
-    // One vertex per fan of corners joined by folds.
-    let mut vertex_of: HashMap<u32, u32> = HashMap::new();
-    let mut vertices: Vec<DVec3> = Vec::new();
-    let mut corner_vertex = |h: HalfedgeId, vertices: &mut Vec<DVec3>| -> u32 {
-        let key = islands.joined.find(h.0);
-        *vertex_of.entry(key).or_insert_with(|| {
-            vertices.push(mesh.position(mesh.origin(h)));
-            (vertices.len() - 1) as u32
-        })
+fn island_panel(net: &BuiltNet, number: u32, faces: &[u32]) -> Panel {
+    let mut parts = PanelParts::default();
+    let tab_bases = island_faces(net, faces, &mut parts);
+    tab_facets(net, tab_bases, &mut parts);
+    folded_holes(net, faces, &mut parts);
+    parts.labels.push(island_label(net, number, faces));
+    let source = Source {
+        id: Name::new(&ISLAND, number),
+        covers: Covers::Faces(number - 1),
     };
-    let mut facets = Loops::new();
-    let mut tab_facets: Vec<(EdgeId, u32, u32)> = Vec::new();
-    let mut labels = Vec::new();
-    let mut holes = Vec::new();
+    Panel::new(
+        source,
+        parts.vertices,
+        parts.facets,
+        parts.holes,
+        parts.labels,
+    )
+}
+
+/// The island's faces as facets, one vertex per fan of corners joined by folds, each
+/// tab's base corners in the facet of the face that owns it, and the match number
+/// inside each face at a cut edge whose tab is not its own; returns the owned tabs'
+/// edges and base corners.
+fn island_faces(net: &BuiltNet, faces: &[u32], parts: &mut PanelParts) -> Vec<(EdgeId, u32, u32)> {
+    let (mesh, tabs) = (net.mesh, net.tabs);
+    let height = net.options.panel.label_height;
+    let mut vertex_of: HashMap<u32, u32> = HashMap::new();
+    let mut tab_bases = Vec::new();
     for &f in faces {
         let f = FaceId(f);
         let mut facet = Vec::new();
         for h in mesh.face_half_edges(f) {
-            facet.push(corner_vertex(h, &mut vertices));
+            let key = net.islands.joined.find(h.0);
+            facet.push(*vertex_of.entry(key).or_insert_with(|| {
+                parts.vertices.push(mesh.position(mesh.origin(h)));
+                (parts.vertices.len() - 1) as u32
+            }));
             let e = h.edge();
-            if let Some(tab) = tabs[e.index()].as_ref().filter(|t| t.owner == h) {
-                vertices.push(tab.base[0]);
-                vertices.push(tab.base[1]);
-                let n = vertices.len() as u32;
-                facet.push(n - 2);
-                facet.push(n - 1);
-                tab_facets.push((e, n - 2, n - 1));
+            let own_tab = tabs[e.index()].as_ref().filter(|t| t.owner == h);
+            if let Some(tab) = own_tab {
+                parts.vertices.extend(tab.base);
+                let n = parts.vertices.len() as u32;
+                facet.extend([n - 2, n - 1]);
+                tab_bases.push((e, n - 2, n - 1));
             }
             // The match number inside this face at a cut edge, unless its tab carries it.
-            if let Some(&m) = match_of.get(&e.0) {
-                let owns_tab = tabs[e.index()].as_ref().is_some_and(|t| t.owner == h);
-                if !owns_tab {
-                    let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
-                    labels.push(Label {
-                        text: Name::new(&MATCH, m),
-                        anchor: 0.5 * (a + b),
-                        direction: (b - a).normalize(),
-                        height,
-                        facet: facet_of[f.index()],
-                        kind: LabelKind::Partner,
-                        on_edge: true,
-                        slide: 0.3 * a.distance(b),
-                    });
-                }
+            if let (Some(&m), None) = (net.match_of.get(&e.0), own_tab) {
+                let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
+                parts.labels.push(Label {
+                    text: Name::new(&MATCH, m),
+                    anchor: 0.5 * (a + b),
+                    direction: (b - a).normalize(),
+                    height,
+                    facet: net.facet_of[f.index()],
+                    kind: LabelKind::Partner,
+                    on_edge: true,
+                    slide: 0.3 * a.distance(b),
+                });
             }
         }
-        facets.push(facet);
+        parts.facets.push(facet);
     }
-    for (e, a_base, b_base) in tab_facets {
-        let Some(placed) = tabs[e.index()].as_ref() else {
+    tab_bases
+}
+
+/// Each owned tab as a facet from its base corners (`tab_bases`) through its top, with
+/// its match number and fastener holes.
+fn tab_facets(net: &BuiltNet, tab_bases: Vec<(EdgeId, u32, u32)>, parts: &mut PanelParts) {
+    for (e, a_base, b_base) in tab_bases {
+        let Some(placed) = net.tabs[e.index()].as_ref() else {
             continue;
         };
-        let facet_index = facets.len() as u32;
+        let facet_index = parts.facets.len() as u32;
         let mut facet = vec![b_base, a_base];
         for &p in &placed.top {
-            vertices.push(p);
-            facet.push((vertices.len() - 1) as u32);
+            parts.vertices.push(p);
+            facet.push((parts.vertices.len() - 1) as u32);
         }
-        facets.push(facet);
+        parts.facets.push(facet);
         let (a, b) = (placed.base[0], placed.base[1]);
-        labels.push(Label {
-            text: Name::new(&MATCH, match_of[&e.0]),
+        parts.labels.push(Label {
+            text: Name::new(&MATCH, net.match_of[&e.0]),
             anchor: 0.5 * (a + b),
             direction: (a - b).normalize(),
-            height,
+            height: net.options.panel.label_height,
             facet: facet_index,
             kind: LabelKind::Partner,
             on_edge: true,
             slide: 0.2 * a.distance(b),
         });
-        for &p in &placed.holes {
-            holes.push(Hole {
-                position: p,
-                diameter: options.panel.hole_diameter,
-                connection: e.0,
-                facet: facet_index,
-            });
-        }
+        parts.holes.extend(placed.holes.iter().map(|&p| Hole {
+            position: p,
+            diameter: net.options.panel.hole_diameter,
+            connection: e.0,
+            facet: facet_index,
+        }));
     }
-    // Holes of tabs other islands (or this one) fold onto these faces.
+}
+
+/// The holes of tabs other islands (or this one) fold onto the island's faces.
+fn folded_holes(net: &BuiltNet, faces: &[u32], parts: &mut PanelParts) {
     for &f in faces {
-        for h in mesh.face_half_edges(FaceId(f)) {
-            if let Some(placed) = tabs[h.edge().index()]
+        for h in net.mesh.face_half_edges(FaceId(f)) {
+            let Some(placed) = net.tabs[h.edge().index()]
                 .as_ref()
                 .filter(|t| t.owner == h.twin())
-            {
-                for &p in &placed.holes {
-                    holes.push(Hole {
-                        position: p,
-                        diameter: options.panel.hole_diameter,
-                        connection: h.edge().0,
-                        facet: facet_of[f as usize],
-                    });
-                }
-            }
+            else {
+                continue;
+            };
+            parts.holes.extend(placed.holes.iter().map(|&p| Hole {
+                position: p,
+                diameter: net.options.panel.hole_diameter,
+                connection: h.edge().0,
+                facet: net.facet_of[f as usize],
+            }));
         }
     }
-    // The island id on the largest face near the island's middle.
-    let label_face = central_face(mesh, islands, faces);
+}
+
+/// The island's id on the largest face near its middle, along that face's longest
+/// edge.
+fn island_label(net: &BuiltNet, number: u32, faces: &[u32]) -> Label {
+    let mesh = net.mesh;
+    let label_face = central_face(mesh, net.islands, faces);
     let corners: Vec<DVec3> = mesh.face_positions(FaceId(label_face)).collect();
     let longest = (0..corners.len())
         .max_by(|&i, &j| {
@@ -1216,21 +1263,16 @@ fn island_panel(
             li.total_cmp(&lj).then(j.cmp(&i))
         })
         .unwrap_or(0);
-    labels.push(Label {
+    Label {
         text: Name::new(&ISLAND, number),
         anchor: mesh.face_centre(FaceId(label_face)),
         direction: (corners[(longest + 1) % corners.len()] - corners[longest]).normalize(),
-        height,
-        facet: facet_of[label_face as usize],
+        height: net.options.panel.label_height,
+        facet: net.facet_of[label_face as usize],
         kind: LabelKind::Panel,
         on_edge: false,
         slide: 0.0,
-    });
-    let source = Source {
-        id: Name::new(&ISLAND, number),
-        covers: Covers::Faces(number - 1),
-    };
-    Panel::new(source, vertices, facets, holes, labels)
+    }
 }
 
 /// The face that shows an island's id: the largest among those whose centre lies in

@@ -119,176 +119,14 @@ struct Corner {
 /// ([`edge_scheme`]).
 fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (band3, b, frame) = band(mesh, f, options);
-    let n = b.len();
     let half_edges = corner_half_edges(mesh, f);
-    let panel = &options.panel;
-    // Inner line of band edge k at depth `depth`: parallel to the edge and directed
-    // like it, through band corner k moved `depth` of the way to the centre (the
-    // frame's origin; beyond it for depths over 1). The flap is the band
-    // clipped to the strip between its edge and that line: the same as running its
-    // sides along the neighbouring band edges, and it never leaves the band when a
-    // neighbouring edge is nearly parallel (sliver triangles).
-    let inner_line = |k: usize, depth: f64| {
-        let p = (1.0 - depth) * b[k];
-        (p, p + (b[(k + 1) % n] - b[k]))
-    };
-    let flap_at = |k: usize, depth: f64| -> Vec<DVec2> {
-        let (p, q) = inner_line(k, depth);
-        // Left of q → p is between the edge and the inner line.
-        let clipped = clip_half_plane(&b, q, p);
-        // Start the loop at B_k, B_k+1 (both kept exactly by the clip).
-        let start = clipped.iter().position(|&x| x == b[k]).unwrap_or(0);
-        (0..clipped.len())
-            .map(|i| clipped[(start + i) % clipped.len()])
-            .collect()
-    };
-    // The overlap at corner k with both flaps at `depth`: the previous edge's flap
-    // clipped by this edge's strip, and its pins.
-    let corner_pins = |k: usize, depth: f64, wanted: u32| {
-        let prev = (k + n - 1) % n;
-        let (p, q) = inner_line(k, depth);
-        let overlap = clip_half_plane(&flap_at(prev, depth), q, p);
-        let centre = if overlap.is_empty() {
-            b[k]
-        } else {
-            overlap.iter().copied().sum::<DVec2>() / overlap.len() as f64
-        };
-        // At --flap-scale pins sit about the overlap's centre, with the most material
-        // around them; in grown flaps, or where they do not fit there, they hug the
-        // corner along its bisector, as near as the margins let them (far from the
-        // face's other flaps, which grow too).
-        let (e1, e2) = (
-            (b[(k + 1) % n] - b[k]).normalize_or_zero(),
-            (b[prev] - b[k]).normalize_or_zero(),
-        );
-        let u = (e1 + e2).normalize_or_zero();
-        let sin_half = e1.perp_dot(u).abs().max(1e-6);
-        let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
-        let hug = |pins: u32| {
-            // The inner of two pins along the bisector is `hole_diameter` nearer the
-            // corner than their centre (see `place_pins`).
-            let offset = if pins >= 2 { panel.hole_diameter } else { 0.0 };
-            b[k] + u * ((clear * 1.0001) / sin_half + offset)
-        };
-        let tries = if depth > options.flap_scale {
-            [hug(wanted.min(2)), hug(1), centre]
-        } else {
-            [centre, hug(wanted.min(2)), hug(1)]
-        };
-        // Two pins lie along the bisector, or, in an overlap long along one of its
-        // band edges (a thin face), about its centre along that edge.
-        let tries = tries
-            .into_iter()
-            .map(|c| (c, u))
-            .chain([(centre, e1), (centre, e2)]);
-        let best = tries
-            .map(|(c, along)| (c, place_pins(&overlap, c, along, wanted, panel).0))
-            .fold((centre, Vec::new()), |best, tried| {
-                // The first of the most wins ties.
-                if tried.1.len() > best.1.len() {
-                    tried
-                } else {
-                    best
-                }
-            });
-        (centre, best.1)
-    };
-    let deepest = if options.deep_flaps {
-        MAX_FLAP_SCALE
-    } else {
-        SHALLOW_FLAP_SCALE
-    };
-    let range = (deepest - options.flap_scale).max(0.0);
-    let steps = (range / FLAP_STEP).ceil().max(1.0) as u32;
-    let depths: Vec<f64> = (0..steps + 1)
-        .map(|i| options.flap_scale + range * f64::from(i) / f64::from(steps))
-        .collect();
-    // Per corner: the shallowest depth at which its two flaps hold `wanted` pins, with
-    // the pins (placed for that depth, they stay valid when the flaps grow deeper:
-    // only their inner lines move, away from the pins).
-    let plan = |k: usize, wanted: u32| -> Option<Corner> {
-        depths.iter().find_map(|&depth| {
-            let (centre, pins) = corner_pins(k, depth, wanted);
-            (pins.len() as u32 >= wanted).then_some(Corner {
-                depth,
-                centre,
-                pins,
-            })
-        })
-    };
-    let flap_depths = |corners: &[Corner]| -> Vec<f64> {
-        (0..n)
-            .map(|k| corners[k].depth.max(corners[(k + 1) % n].depth))
-            .collect()
-    };
-    // A pin goes through the two flaps of its corner only: the face's other flaps,
-    // which grow too in small faces, must stay clear of it, notched round it where
-    // they would not (see `notch_flap`). The flaps of a plan, `None` where a notch
-    // cannot be cut or would come too near a flap's own pins.
-    let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
-    let apart =
-        |pin: DVec2, flap: &[DVec2]| !contains(flap, pin) && distance_to_border(flap, pin) >= clear;
-    let flaps_for = |corners: &[Corner]| -> Option<Vec<Vec<DVec2>>> {
-        let depths = flap_depths(corners);
-        (0..n)
-            .map(|j| {
-                let flap = flap_at(j, depths[j]);
-                let own = [j, (j + 1) % n];
-                let foreign: Vec<DVec2> = (0..n)
-                    .filter(|k| !own.contains(k))
-                    .flat_map(|k| corners[k].pins.iter().copied())
-                    .filter(|&pin| !apart(pin, &flap))
-                    .collect();
-                if foreign.is_empty() {
-                    return Some(flap);
-                }
-                let notched = notch_flap(&flap, &foreign, clear, panel.hole_margin)?;
-                let holds_own = own.iter().flat_map(|&k| &corners[k].pins).all(|&pin| {
-                    contains(&notched, pin) && distance_to_border(&notched, pin) >= clear
-                });
-                holds_own.then_some(notched)
-            })
-            .collect()
-    };
-    // First one pin at every corner that can hold one, with the shallowest flaps;
-    // where those clash, corner by corner in order, each kept only if the flaps can
-    // still be cut with it (a corner left without keeps the shallowest flaps). Then
-    // corner by corner the wanted count, where the deeper flaps it takes still can.
-    let bare_corner = |k: usize| {
-        let (centre, _) = corner_pins(k, depths[0], 0);
-        Corner {
-            depth: depths[0],
-            centre,
-            pins: Vec::new(),
-        }
-    };
-    let planned: Vec<Corner> = (0..n)
-        .map(|k| plan(k, panel.holes.min(1)).unwrap_or_else(|| bare_corner(k)))
-        .collect();
-    let mut corners = planned.clone();
-    if flaps_for(&corners).is_none() {
-        corners = (0..n).map(bare_corner).collect();
-        for (k, corner) in planned.into_iter().enumerate() {
-            let mut tried = corners.clone();
-            tried[k] = corner;
-            if flaps_for(&tried).is_some() {
-                corners = tried;
-            }
-        }
-    }
-    if panel.holes > 1 {
-        for k in 0..n {
-            if let Some(full) = plan(k, panel.holes) {
-                let mut tried = corners.clone();
-                tried[k] = full;
-                if flaps_for(&tried).is_some() {
-                    corners = tried;
-                }
-            }
-        }
-    }
-    let flaps = flaps_for(&corners).expect("every step above kept flaps that can be cut");
+    let face = FlatBand::new(b, options);
+    let corners = face.corners();
+    let flaps = face
+        .flaps_for(&corners)
+        .expect("every step of `corners` kept flaps that can be cut");
 
+    let (n, panel) = (face.b.len(), &options.panel);
     let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
     for flap in &flaps {
         parts.push_flap(flap.iter().skip(2).map(|&q| frame.to3(q)));
@@ -311,4 +149,203 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     }
     parts.shrink_to_fit();
     parts
+}
+
+/// A face's band in its own plane (centre at the origin) with the flap depths its
+/// corners may try, shallowest first.
+struct FlatBand<'a> {
+    /// Band corners.
+    b: Vec<DVec2>,
+    options: &'a EdgeOptions,
+    /// From `--flap-scale` to the deepest allowed, in steps of [`FLAP_STEP`].
+    depths: Vec<f64>,
+}
+
+impl<'a> FlatBand<'a> {
+    fn new(b: Vec<DVec2>, options: &'a EdgeOptions) -> Self {
+        let deepest = if options.deep_flaps {
+            MAX_FLAP_SCALE
+        } else {
+            SHALLOW_FLAP_SCALE
+        };
+        let range = (deepest - options.flap_scale).max(0.0);
+        let steps = (range / FLAP_STEP).ceil().max(1.0) as u32;
+        let depths = (0..steps + 1)
+            .map(|i| options.flap_scale + range * f64::from(i) / f64::from(steps))
+            .collect();
+        FlatBand { b, options, depths }
+    }
+
+    /// Inner line of band edge k at depth `depth`: parallel to the edge and directed
+    /// like it, through band corner k moved `depth` of the way to the centre (beyond
+    /// it for depths over 1). The flap is the band clipped to the strip between its
+    /// edge and that line: the same as running its sides along the neighbouring band
+    /// edges, and it never leaves the band when a neighbouring edge is nearly parallel
+    /// (sliver triangles).
+    fn inner_line(&self, k: usize, depth: f64) -> (DVec2, DVec2) {
+        let b = &self.b;
+        let p = (1.0 - depth) * b[k];
+        (p, p + (b[(k + 1) % b.len()] - b[k]))
+    }
+
+    /// Band edge k's flap at `depth`, starting at B_k, B_k+1.
+    fn flap_at(&self, k: usize, depth: f64) -> Vec<DVec2> {
+        let (p, q) = self.inner_line(k, depth);
+        // Left of q → p is between the edge and the inner line.
+        let clipped = clip_half_plane(&self.b, q, p);
+        // Start the loop at B_k, B_k+1 (both kept exactly by the clip).
+        let start = clipped.iter().position(|&x| x == self.b[k]).unwrap_or(0);
+        (0..clipped.len())
+            .map(|i| clipped[(start + i) % clipped.len()])
+            .collect()
+    }
+
+    /// The overlap at corner k with both flaps at `depth` (the previous edge's flap
+    /// clipped by this edge's strip): its centre and the most pins, up to `wanted`,
+    /// that it holds.
+    fn corner_pins(&self, k: usize, depth: f64, wanted: u32) -> (DVec2, Vec<DVec2>) {
+        let (b, n, panel) = (&self.b, self.b.len(), &self.options.panel);
+        let prev = (k + n - 1) % n;
+        let (p, q) = self.inner_line(k, depth);
+        let overlap = clip_half_plane(&self.flap_at(prev, depth), q, p);
+        let centre = if overlap.is_empty() {
+            b[k]
+        } else {
+            overlap.iter().copied().sum::<DVec2>() / overlap.len() as f64
+        };
+        // At --flap-scale pins sit about the overlap's centre, with the most material
+        // around them; in grown flaps, or where they do not fit there, they hug the
+        // corner along its bisector, as near as the margins let them (far from the
+        // face's other flaps, which grow too).
+        let (e1, e2) = (
+            (b[(k + 1) % n] - b[k]).normalize_or_zero(),
+            (b[prev] - b[k]).normalize_or_zero(),
+        );
+        let u = (e1 + e2).normalize_or_zero();
+        let sin_half = e1.perp_dot(u).abs().max(1e-6);
+        let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
+        let hug = |pins: u32| {
+            // The inner of two pins along the bisector is `hole_diameter` nearer the
+            // corner than their centre (see `place_pins`).
+            let offset = if pins >= 2 { panel.hole_diameter } else { 0.0 };
+            b[k] + u * ((clear * 1.0001) / sin_half + offset)
+        };
+        let tries = if depth > self.options.flap_scale {
+            [hug(wanted.min(2)), hug(1), centre]
+        } else {
+            [centre, hug(wanted.min(2)), hug(1)]
+        };
+        // Two pins lie along the bisector, or, in an overlap long along one of its
+        // band edges (a thin face), about its centre along that edge.
+        let tries = tries
+            .into_iter()
+            .map(|c| (c, u))
+            .chain([(centre, e1), (centre, e2)]);
+        let best = tries
+            .map(|(c, along)| (c, place_pins(&overlap, c, along, wanted, panel).0))
+            .fold((centre, Vec::new()), |best, tried| {
+                // The first of the most wins ties.
+                if tried.1.len() > best.1.len() {
+                    tried
+                } else {
+                    best
+                }
+            });
+        (centre, best.1)
+    }
+
+    /// Corner k's plan for `wanted` pins: the shallowest depth at which its two flaps
+    /// hold them, with the pins (placed for that depth, they stay valid when the flaps
+    /// grow deeper: only their inner lines move, away from the pins).
+    fn plan(&self, k: usize, wanted: u32) -> Option<Corner> {
+        self.depths.iter().find_map(|&depth| {
+            let (centre, pins) = self.corner_pins(k, depth, wanted);
+            (pins.len() as u32 >= wanted).then_some(Corner {
+                depth,
+                centre,
+                pins,
+            })
+        })
+    }
+
+    /// Corner k with the shallowest flaps and no pins.
+    fn bare_corner(&self, k: usize) -> Corner {
+        let (centre, _) = self.corner_pins(k, self.depths[0], 0);
+        Corner {
+            depth: self.depths[0],
+            centre,
+            pins: Vec::new(),
+        }
+    }
+
+    /// The flaps of a plan. A pin goes through the two flaps of its corner only: the
+    /// face's other flaps, which grow too in small faces, must stay clear of it,
+    /// notched round it where they would not (see `notch_flap`). `None` where a notch
+    /// cannot be cut or would come too near a flap's own pins.
+    fn flaps_for(&self, corners: &[Corner]) -> Option<Vec<Vec<DVec2>>> {
+        let (n, panel) = (self.b.len(), &self.options.panel);
+        let clear = 0.5 * panel.hole_diameter + panel.hole_margin;
+        let apart = |pin: DVec2, flap: &[DVec2]| {
+            !contains(flap, pin) && distance_to_border(flap, pin) >= clear
+        };
+        (0..n)
+            .map(|j| {
+                // A flap is as deep as the deeper of its two corners needs.
+                let depth = corners[j].depth.max(corners[(j + 1) % n].depth);
+                let flap = self.flap_at(j, depth);
+                let own = [j, (j + 1) % n];
+                let foreign: Vec<DVec2> = (0..n)
+                    .filter(|k| !own.contains(k))
+                    .flat_map(|k| corners[k].pins.iter().copied())
+                    .filter(|&pin| !apart(pin, &flap))
+                    .collect();
+                if foreign.is_empty() {
+                    return Some(flap);
+                }
+                let notched = notch_flap(&flap, &foreign, clear, panel.hole_margin)?;
+                let holds_own = own.iter().flat_map(|&k| &corners[k].pins).all(|&pin| {
+                    contains(&notched, pin) && distance_to_border(&notched, pin) >= clear
+                });
+                holds_own.then_some(notched)
+            })
+            .collect()
+    }
+
+    /// Every corner's plan. First one pin at every corner that can hold one, with the
+    /// shallowest flaps; where those clash, corner by corner in order, each kept only
+    /// if the flaps can still be cut with it (a corner left without keeps the
+    /// shallowest flaps). Then corner by corner the wanted count, where the deeper
+    /// flaps it takes still can.
+    fn corners(&self) -> Vec<Corner> {
+        let (n, holes) = (self.b.len(), self.options.panel.holes);
+        let planned: Vec<Corner> = (0..n)
+            .map(|k| {
+                self.plan(k, holes.min(1))
+                    .unwrap_or_else(|| self.bare_corner(k))
+            })
+            .collect();
+        let mut corners = planned.clone();
+        if self.flaps_for(&corners).is_none() {
+            corners = (0..n).map(|k| self.bare_corner(k)).collect();
+            for (k, corner) in planned.into_iter().enumerate() {
+                let mut tried = corners.clone();
+                tried[k] = corner;
+                if self.flaps_for(&tried).is_some() {
+                    corners = tried;
+                }
+            }
+        }
+        if holes > 1 {
+            for k in 0..n {
+                if let Some(full) = self.plan(k, holes) {
+                    let mut tried = corners.clone();
+                    tried[k] = full;
+                    if self.flaps_for(&tried).is_some() {
+                        corners = tried;
+                    }
+                }
+            }
+        }
+        corners
+    }
 }
