@@ -1,6 +1,7 @@
 //! `unfold inspect`: a model's topology, geometry and every repair the build would make,
 //! as text or JSON.
 
+use std::fmt::Write;
 use std::path::Path;
 
 use serde::Serialize;
@@ -155,12 +156,18 @@ pub fn inspect(
 impl Inspection {
     /// The human-readable report.
     pub fn to_text(&self) -> String {
-        use std::fmt::Write;
         let mut s = String::new();
-        let i = &self.input;
-        let m = &self.mesh;
-        let g = &self.geometry;
         let _ = writeln!(s, "{} ({:?})", self.path, self.format);
+        self.write_input(&mut s);
+        self.write_topology(&mut s);
+        self.write_geometry(&mut s);
+        self.write_preparation(&mut s);
+        s
+    }
+
+    /// Writes the counts of the file as it is and, with `--weld`, of the welded soup.
+    fn write_input(&self, s: &mut String) {
+        let i = &self.input;
         let _ = writeln!(
             s,
             "input:       vertices {}  edges {}  faces {}  boundary edges {}  euler {}",
@@ -186,6 +193,11 @@ impl Inspection {
                 w.vertices, w.edges, w.faces, w.boundary_edges, w.euler_characteristic
             );
         }
+    }
+
+    /// Writes the prepared mesh's counts, topology and first ten components.
+    fn write_topology(&self, s: &mut String) {
+        let m = &self.mesh;
         let _ = writeln!(
             s,
             "mesh:        vertices {}  edges {}  faces {}  boundary edges {}  boundary loops {}",
@@ -221,7 +233,14 @@ impl Inspection {
                 m.components.len() - 10
             );
         }
-        let sizes: Vec<String> = m
+    }
+
+    /// Writes face sizes, the size and area in model units and as built, planarity and
+    /// what planarization would do.
+    fn write_geometry(&self, s: &mut String) {
+        let g = &self.geometry;
+        let sizes: Vec<String> = self
+            .mesh
             .face_sizes
             .iter()
             .map(|(n, count)| format!("{n}-gons {count}"))
@@ -264,6 +283,11 @@ impl Inspection {
                 units::short_number(r.max_displacement / self.physical.mm_per_unit)
             );
         }
+    }
+
+    /// Writes the faces each scheme would split, the groups, the ignored statements and
+    /// the notes.
+    fn write_preparation(&self, s: &mut String) {
         let splits: Vec<String> = self
             .preparation
             .iter()
@@ -299,6 +323,5 @@ impl Inspection {
                 let _ = writeln!(s, "  - {}", note.message);
             }
         }
-        s
     }
 }

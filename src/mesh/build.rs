@@ -91,11 +91,53 @@ pub fn build_mesh(
     }
     check_faces(polys)?;
     let corners = CornerEdges::new(polys);
-    let corner_count = polys.indices.len();
+    let (group_of_corner, group_count) = pair_corners(polys, &corners)?;
+    let fans = corner_fans(polys, &corners);
+    drop(corners);
+    let (corner_half_edge, edge_count) = number_half_edges(&group_of_corner, group_count);
+    drop(group_of_corner);
 
-    // Pair corners into edges; edges are numbered in the order their first corner
-    // appears in the file, so edge ids follow the user's face order.
-    let mut group_of_corner = vec![0u32; corner_count];
+    let (mut tables, face_half_edge) = link_faces(polys, &corner_half_edge, edge_count);
+    let vertices = split_fans(
+        polys,
+        vertex_source,
+        &fans,
+        &corner_half_edge,
+        &mut tables.origin,
+    );
+    drop(fans);
+    drop(corner_half_edge);
+
+    let boundary_out = link_boundary(&mut tables, vertices.positions.len());
+    let vertex_half_edge = vertex_half_edges(&tables.origin, &boundary_out)?;
+    let report = split_report(&vertices.extra_fans, &vertices.source);
+    let face_source_out = match face_source {
+        Some(s) => s.to_vec(),
+        None => (0..polys.face_count() as u32).collect(),
+    };
+    let mesh = Mesh {
+        positions: vertices.positions,
+        vertex_half_edge,
+        half_edge_next: tables.next,
+        half_edge_prev: tables.prev,
+        half_edge_origin: tables.origin,
+        half_edge_face: tables.face,
+        face_half_edge,
+        vertex_source: vertices.source,
+        face_source: face_source_out,
+    };
+    Ok((mesh, report))
+}
+
+/// A half-edge slot not filled in yet.
+const UNSET: HalfedgeId = HalfedgeId(u32::MAX);
+
+/// Groups the corners by the undirected edge they start (one group per edge, in the
+/// order of the edge keys) and returns each corner's group and the number of groups.
+/// Rejects edges of three or more faces and edges two faces run through in the same
+/// direction.
+fn pair_corners(polys: &Polygons, corners: &CornerEdges) -> Result<(Vec<u32>, u32), BuildError> {
+    let mut group_of_corner = vec![0u32; polys.indices.len()];
     let mut group_count = 0u32;
     for group in corners.groups() {
         if group.len() > 2 {
@@ -129,11 +171,15 @@ pub fn build_mesh(
         }
         group_count += 1;
     }
-    let fans = corner_fans(polys, &corners);
-    drop(corners);
+    Ok((group_of_corner, group_count))
+}
 
+/// The half-edge of every corner and the number of edges. Edges are numbered in the
+/// order their first corner appears in the file, so edge ids follow the user's face
+/// order; that first corner gets the even half-edge of the pair.
+fn number_half_edges(group_of_corner: &[u32], group_count: u32) -> (Vec<HalfedgeId>, u32) {
     let mut edge_of_group = vec![u32::MAX; group_count as usize];
-    let mut corner_half_edge = vec![HalfedgeId(0); corner_count];
+    let mut corner_half_edge = vec![HalfedgeId(0); group_of_corner.len()];
     let mut edge_count = 0u32;
     for (c, &g) in group_of_corner.iter().enumerate() {
         let slot = &mut edge_of_group[g as usize];
@@ -145,14 +191,35 @@ pub fn build_mesh(
             HalfedgeId(2 * *slot + 1)
         };
     }
-    drop(group_of_corner);
-    drop(edge_of_group);
+    (corner_half_edge, edge_count)
+}
 
+/// The per-half-edge tables of the mesh being built.
+struct HalfedgeTables {
+    /// The next half-edge around the face (or boundary loop).
+    next: Vec<HalfedgeId>,
+    /// The previous half-edge around the face (or boundary loop).
+    prev: Vec<HalfedgeId>,
+    /// The face on the left, or [`NO_FACE`] on the boundary.
+    face: Vec<u32>,
+    /// The vertex each half-edge starts at.
+    origin: Vec<VertexId>,
+}
+
+/// Links the half-edges of every face into its loop; returns the tables (boundary
+/// half-edges and origins still unset) and the first half-edge of every face.
+fn link_faces(
+    polys: &Polygons,
+    corner_half_edge: &[HalfedgeId],
+    edge_count: u32,
+) -> (HalfedgeTables, Vec<HalfedgeId>) {
     let half_edge_count = 2 * edge_count as usize;
-    let unset = HalfedgeId(u32::MAX);
-    let mut next = vec![unset; half_edge_count];
-    let mut prev = vec![unset; half_edge_count];
-    let mut face_of = vec![NO_FACE; half_edge_count];
+    let mut tables = HalfedgeTables {
+        next: vec![UNSET; half_edge_count],
+        prev: vec![UNSET; half_edge_count],
+        face: vec![NO_FACE; half_edge_count],
+        origin: vec![VertexId(u32::MAX); half_edge_count],
+    };
     let mut face_half_edge = Vec::with_capacity(polys.face_count());
     for f in 0..polys.face_count() {
         let (start, end) = (polys.offsets[f] as usize, polys.offsets[f + 1] as usize);
@@ -161,24 +228,43 @@ pub fn build_mesh(
             let h = corner_half_edge[c].index();
             let n = if c + 1 == end { start } else { c + 1 };
             let hn = corner_half_edge[n];
-            next[h] = hn;
-            prev[hn.index()] = HalfedgeId(h as u32);
-            face_of[h] = f as u32;
+            tables.next[h] = hn;
+            tables.prev[hn.index()] = HalfedgeId(h as u32);
+            tables.face[h] = f as u32;
         }
     }
+    (tables, face_half_edge)
+}
 
-    // One vertex per fan: the first fan of a soup vertex keeps its index, later fans
-    // get new vertices appended (in half-edge order, so the result is deterministic).
+/// The vertices of the mesh: one per fan of faces around a soup vertex.
+struct FanVertices {
+    /// Positions: the soup's, then one copy for every extra fan.
+    positions: Vec<DVec3>,
+    /// The user's vertex index of every vertex.
+    source: Vec<u32>,
+    /// The soup vertex of every extra fan (one entry per vertex appended).
+    extra_fans: Vec<u32>,
+}
+
+/// Makes one vertex per fan and sets the origin of every face half-edge. The first fan
+/// of a soup vertex keeps its index; later fans get new vertices appended, in half-edge
+/// order so that the result is deterministic.
+fn split_fans(
+    polys: &Polygons,
+    vertex_source: Option<&[u32]>,
+    fans: &[u32],
+    corner_half_edge: &[HalfedgeId],
+    origin: &mut [VertexId],
+) -> FanVertices {
     let soup_vertex_count = polys.positions.len();
     let mut positions = polys.positions.clone();
-    let mut vertex_source_out: Vec<u32> = match vertex_source {
+    let mut source: Vec<u32> = match vertex_source {
         Some(s) => s.to_vec(),
         None => (0..soup_vertex_count as u32).collect(),
     };
     let mut first_root = vec![u32::MAX; soup_vertex_count];
-    let mut vertex_of_root = vec![u32::MAX; corner_count];
-    let mut fans_of_vertex: Vec<(u32, u32)> = Vec::new();
-    let mut origin = vec![VertexId(u32::MAX); half_edge_count];
+    let mut vertex_of_root = vec![u32::MAX; polys.indices.len()];
+    let mut extra_fans: Vec<u32> = Vec::new();
     for (c, &root) in fans.iter().enumerate() {
         let root = root as usize;
         if vertex_of_root[root] == u32::MAX {
@@ -189,80 +275,84 @@ pub fn build_mesh(
             } else {
                 vertex_of_root[root] = positions.len() as u32;
                 positions.push(positions[sv]);
-                vertex_source_out.push(vertex_source_out[sv]);
-                fans_of_vertex.push((sv as u32, 0));
+                source.push(source[sv]);
+                extra_fans.push(sv as u32);
             }
         }
         origin[corner_half_edge[c].index()] = VertexId(vertex_of_root[root]);
     }
-    drop(fans);
-    drop(vertex_of_root);
-    drop(corner_half_edge);
+    FanVertices {
+        positions,
+        source,
+        extra_fans,
+    }
+}
 
-    // Boundary half-edges: the twin of face half-edge u→w runs w→u; its origin is the
-    // origin of next(h). Each (post-split) vertex has at most one outgoing boundary
-    // half-edge, so boundary loops link without ambiguity.
-    let vertex_count = positions.len();
-    let mut boundary_out = vec![unset; vertex_count];
+/// Sets the origins of the boundary half-edges and links them into boundary loops;
+/// returns every vertex's outgoing boundary half-edge ([`UNSET`] for interior ones).
+///
+/// The twin of face half-edge u→w runs w→u, so its origin is the origin of next(h). Each
+/// (post-split) vertex has at most one outgoing boundary half-edge, so boundary loops
+/// link without ambiguity.
+fn link_boundary(tables: &mut HalfedgeTables, vertex_count: usize) -> Vec<HalfedgeId> {
+    let half_edge_count = tables.face.len();
+    let mut boundary_out = vec![UNSET; vertex_count];
     for h in 0..half_edge_count {
-        if face_of[h] == NO_FACE {
+        if tables.face[h] == NO_FACE {
             let interior = HalfedgeId(h as u32).twin();
-            let o = origin[next[interior.index()].index()];
-            origin[h] = o;
+            let o = tables.origin[tables.next[interior.index()].index()];
+            tables.origin[h] = o;
             boundary_out[o.index()] = HalfedgeId(h as u32);
         }
     }
     for h in 0..half_edge_count {
-        if face_of[h] == NO_FACE {
-            let head = origin[HalfedgeId(h as u32).twin().index()];
+        if tables.face[h] == NO_FACE {
+            let head = tables.origin[HalfedgeId(h as u32).twin().index()];
             let n = boundary_out[head.index()];
-            next[h] = n;
-            prev[n.index()] = HalfedgeId(h as u32);
+            tables.next[h] = n;
+            tables.prev[n.index()] = HalfedgeId(h as u32);
         }
     }
+    boundary_out
+}
 
-    let mut vertex_half_edge = vec![unset; vertex_count];
-    for h in (0..half_edge_count).rev() {
+/// The stored half-edge of every vertex: its boundary half-edge on the boundary, else
+/// its lowest outgoing one. Rejects a vertex with no half-edge.
+fn vertex_half_edges(
+    origin: &[VertexId],
+    boundary_out: &[HalfedgeId],
+) -> Result<Vec<HalfedgeId>, BuildError> {
+    let mut vertex_half_edge = vec![UNSET; boundary_out.len()];
+    for h in (0..origin.len()).rev() {
         // Reverse order so the lowest outgoing half-edge wins for interior vertices.
         vertex_half_edge[origin[h].index()] = HalfedgeId(h as u32);
     }
     for (v, &b) in boundary_out.iter().enumerate() {
-        if b != unset {
+        if b != UNSET {
             vertex_half_edge[v] = b;
         }
     }
-    if let Some(v) = vertex_half_edge.iter().position(|&h| h == unset) {
+    if let Some(v) = vertex_half_edge.iter().position(|&h| h == UNSET) {
         return Err(BuildError::IsolatedVertex { vertex: v as u32 });
     }
+    Ok(vertex_half_edge)
+}
 
+/// The report of split bow-tie vertices: each split soup vertex (in the user's
+/// numbering, from `vertex_source`) with its number of fans.
+fn split_report(extra_fans: &[u32], vertex_source: &[u32]) -> BuildReport {
     let mut report = BuildReport::default();
-    if !fans_of_vertex.is_empty() {
+    if !extra_fans.is_empty() {
         let mut counts = std::collections::BTreeMap::new();
-        for (sv, _) in fans_of_vertex {
+        for &sv in extra_fans {
             *counts.entry(sv).or_insert(1u32) += 1;
         }
         report.split_vertices = counts
             .into_iter()
-            .map(|(sv, n)| (vertex_source_out[sv as usize], n))
+            .map(|(sv, n)| (vertex_source[sv as usize], n))
             .collect();
     }
-
-    let face_source_out = match face_source {
-        Some(s) => s.to_vec(),
-        None => (0..polys.face_count() as u32).collect(),
-    };
-    let mesh = Mesh {
-        positions,
-        vertex_half_edge,
-        half_edge_next: next,
-        half_edge_prev: prev,
-        half_edge_origin: origin,
-        half_edge_face: face_of,
-        face_half_edge,
-        vertex_source: vertex_source_out,
-        face_source: face_source_out,
-    };
-    Ok((mesh, report))
+    report
 }
 
 /// A convenience for tests and examples: builds from positions and face lists.

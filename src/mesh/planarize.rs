@@ -91,21 +91,13 @@ pub fn planarize(
     options: &PlanarizeOptions,
 ) -> Result<PlanarizeReport, PlanarizeError> {
     let polygons: Vec<FaceId> = mesh.faces().filter(|&f| mesh.face_degree(f) > 3).collect();
-    // Corner lists of the constrained faces, by vertex index.
-    let corners: Vec<Vec<u32>> = polygons
-        .iter()
-        .map(|&f| mesh.face_vertices(f).map(|v| v.index() as u32).collect())
-        .collect();
-    let errors_of = |positions: &[DVec3]| -> Vec<f64> {
-        corners
+    let faces = ConstrainedFaces {
+        corners: polygons
             .iter()
-            .map(|face| {
-                let points: Vec<DVec3> = face.iter().map(|&v| positions[v as usize]).collect();
-                planarity_error(&points)
-            })
-            .collect()
+            .map(|&f| mesh.face_vertices(f).map(|v| v.index() as u32).collect())
+            .collect(),
     };
-    let before = errors_of(mesh.positions());
+    let before = faces.errors(mesh.positions());
     let mut report = PlanarizeReport {
         polygons: polygons.len(),
         non_planar_before: before.iter().filter(|&&e| e > options.tolerance).count(),
@@ -119,35 +111,140 @@ pub fn planarize(
 
     // Work in units of the mean edge length so the weights mean the same on any model.
     let unit = mean_edge_length(mesh).max(f64::MIN_POSITIVE);
-    let original: Vec<DVec3> = mesh.positions().iter().map(|&p| p / unit).collect();
-    let mut positions = original.clone();
-    let mut normals: Vec<DVec3> = polygons
-        .iter()
-        .map(|&f| mesh.face_normal(f).try_normalize().unwrap_or(DVec3::Z))
-        .collect();
-    let neighbours: Vec<Vec<u32>> = mesh
-        .vertices()
-        .map(|v| {
-            mesh.vertex_neighbours(v)
-                .map(|n| n.index() as u32)
-                .collect()
-        })
-        .collect();
+    let mut iterate = Iterate::new(mesh, &polygons, unit);
+    report.iterations = iterate.run(&faces, options.max_iterations)?;
+    let result: Vec<DVec3> = iterate.positions.iter().map(|&p| p * unit).collect();
+    apply_if_flatter(mesh, result, &faces, options.tolerance, &mut report);
+    Ok(report)
+}
 
-    let vertex_vars = 3 * positions.len();
-    let unknowns = vertex_vars + 3 * polygons.len();
-    let mut soft = 1.0;
-    for iteration in 0..options.max_iterations {
+/// The faces of four or more corners, whose planarity is constrained.
+struct ConstrainedFaces {
+    /// The corners of each face, by vertex index.
+    corners: Vec<Vec<u32>>,
+}
+
+impl ConstrainedFaces {
+    /// The planarity error of every face at `positions`.
+    fn errors(&self, positions: &[DVec3]) -> Vec<f64> {
+        self.corners
+            .iter()
+            .map(|face| {
+                let points: Vec<DVec3> = face.iter().map(|&v| positions[v as usize]).collect();
+                planarity_error(&points)
+            })
+            .collect()
+    }
+}
+
+/// The unknowns of the guided projection as the iterations move them, in units of the
+/// mean edge length: vertex positions, then one auxiliary normal per constrained face.
+struct Iterate {
+    /// The input positions.
+    original: Vec<DVec3>,
+    /// The current positions.
+    positions: Vec<DVec3>,
+    /// The current normal of every constrained face.
+    normals: Vec<DVec3>,
+    /// The neighbours of every vertex, for the fairness term.
+    neighbours: Vec<Vec<u32>>,
+}
+
+impl Iterate {
+    /// The starting point: the mesh's positions divided by `unit` and the normals of
+    /// the `polygons`.
+    fn new(mesh: &Mesh, polygons: &[FaceId], unit: f64) -> Self {
+        let original: Vec<DVec3> = mesh.positions().iter().map(|&p| p / unit).collect();
+        let normals = polygons
+            .iter()
+            .map(|&f| mesh.face_normal(f).try_normalize().unwrap_or(DVec3::Z))
+            .collect();
+        let neighbours = mesh
+            .vertices()
+            .map(|v| {
+                mesh.vertex_neighbours(v)
+                    .map(|n| n.index() as u32)
+                    .collect()
+            })
+            .collect();
+        Iterate {
+            positions: original.clone(),
+            original,
+            normals,
+            neighbours,
+        }
+    }
+
+    /// The index of the first normal variable, after the three coordinates of every
+    /// vertex.
+    fn vertex_vars(&self) -> usize {
+        3 * self.positions.len()
+    }
+
+    /// Runs up to `max_iterations` steps, halving the soft weights after each, until
+    /// every face is planar to [`CONVERGED`]; returns the number of steps run.
+    fn run(
+        &mut self,
+        faces: &ConstrainedFaces,
+        max_iterations: usize,
+    ) -> Result<usize, PlanarizeError> {
+        let mut iterations = 0;
+        let mut soft = 1.0;
+        for iteration in 0..max_iterations {
+            self.step(faces, soft)?;
+            iterations = iteration + 1;
+            soft *= 0.5;
+            let worst = faces
+                .errors(&self.positions)
+                .into_iter()
+                .fold(0.0, f64::max);
+            if worst < CONVERGED {
+                break;
+            }
+        }
+        Ok(iterations)
+    }
+
+    /// One Gauss–Newton step with the soft weights scaled by `soft`.
+    fn step(&mut self, faces: &ConstrainedFaces, soft: f64) -> Result<(), PlanarizeError> {
+        let unknowns = self.vertex_vars() + 3 * self.normals.len();
         let mut system = NormalEquations::new(unknowns);
-        // Hard constraints, linearised: e·n with e = v_b − v_a is bilinear, so its
-        // linearisation is nᵏ·(v_b − v_a) + eᵏ·n = eᵏ·nᵏ.
-        for (k, face) in corners.iter().enumerate() {
-            let n = normals[k];
+        self.add_constraints(&mut system, faces);
+        self.add_soft_terms(&mut system, soft);
+        // Proximity to the current iterate.
+        let current: Vec<f64> = self
+            .positions
+            .iter()
+            .flat_map(|p| p.to_array())
+            .chain(self.normals.iter().flat_map(|n| n.to_array()))
+            .collect();
+        for (i, &x) in current.iter().enumerate() {
+            system.add(&Row::single(i, 1.0), x, PROXIMITY);
+        }
+        let solution = system.solve()?;
+        for (v, p) in self.positions.iter_mut().enumerate() {
+            *p = DVec3::new(solution[3 * v], solution[3 * v + 1], solution[3 * v + 2]);
+        }
+        let vertex_vars = self.vertex_vars();
+        for (k, n) in self.normals.iter_mut().enumerate() {
+            let at = vertex_vars + 3 * k;
+            *n = DVec3::new(solution[at], solution[at + 1], solution[at + 2]);
+        }
+        Ok(())
+    }
+
+    /// Adds the hard constraints of every face, linearised at the current iterate.
+    fn add_constraints(&self, system: &mut NormalEquations, faces: &ConstrainedFaces) {
+        let vertex_vars = self.vertex_vars();
+        // e·n with e = v_b − v_a is bilinear, so its linearisation is
+        // nᵏ·(v_b − v_a) + eᵏ·n = eᵏ·nᵏ.
+        for (k, face) in faces.corners.iter().enumerate() {
+            let n = self.normals[k];
             let nv = vertex_vars + 3 * k;
             for i in 0..face.len() {
                 let a = face[i] as usize;
                 let b = face[(i + 1) % face.len()] as usize;
-                let e = positions[b] - positions[a];
+                let e = self.positions[b] - self.positions[a];
                 let mut row = Row::default();
                 for axis in 0..3 {
                     row.push(3 * b + axis, n[axis]);
@@ -163,10 +260,14 @@ pub fn planarize(
             }
             system.add(&row, 1.0 + n.dot(n), 1.0);
         }
-        // Soft terms, per coordinate.
+    }
+
+    /// Adds the closeness and fairness terms, per coordinate, weighted by `soft`.
+    fn add_soft_terms(&self, system: &mut NormalEquations, soft: f64) {
         let closeness = CLOSENESS * soft;
         let fairness = FAIRNESS * soft;
-        for (v, (nbrs, home)) in neighbours.iter().zip(&original).enumerate() {
+        let original = &self.original;
+        for (v, (nbrs, home)) in self.neighbours.iter().zip(original).enumerate() {
             for (axis, &home_coordinate) in home.to_array().iter().enumerate() {
                 if closeness > 0.0 {
                     let mut row = Row::default();
@@ -187,50 +288,35 @@ pub fn planarize(
                 }
             }
         }
-        // Proximity to the current iterate.
-        let current: Vec<f64> = positions
-            .iter()
-            .flat_map(|p| p.to_array())
-            .chain(normals.iter().flat_map(|n| n.to_array()))
-            .collect();
-        for (i, &x) in current.iter().enumerate() {
-            system.add(&Row::single(i, 1.0), x, PROXIMITY);
-        }
-        let solution = system.solve()?;
-        for (v, p) in positions.iter_mut().enumerate() {
-            *p = DVec3::new(solution[3 * v], solution[3 * v + 1], solution[3 * v + 2]);
-        }
-        for (k, n) in normals.iter_mut().enumerate() {
-            let at = vertex_vars + 3 * k;
-            *n = DVec3::new(solution[at], solution[at + 1], solution[at + 2]);
-        }
-        report.iterations = iteration + 1;
-        soft *= 0.5;
-        let worst = errors_of(&positions).into_iter().fold(0.0, f64::max);
-        if worst < CONVERGED {
-            break;
-        }
     }
+}
 
-    let result: Vec<DVec3> = positions.iter().map(|&p| p * unit).collect();
-    let after = errors_of(&result);
+/// Moves the mesh to `result` and completes the report when that makes the faces
+/// flatter; otherwise leaves the mesh as it is and reports the input's errors.
+fn apply_if_flatter(
+    mesh: &mut Mesh,
+    result: Vec<DVec3>,
+    faces: &ConstrainedFaces,
+    tolerance: f64,
+    report: &mut PlanarizeReport,
+) {
+    let after = faces.errors(&result);
     let max_after = after.iter().copied().fold(0.0, f64::max);
     let flatter = max_after < report.max_error_before;
     if !flatter {
         // Never hand back a worse mesh (a diverged solve).
         report.non_planar_after = report.non_planar_before;
         report.max_error_after = report.max_error_before;
-        return Ok(report);
+        return;
     }
     report.max_displacement = result
         .iter()
         .zip(mesh.positions())
         .map(|(a, b)| a.distance(*b))
         .fold(0.0, f64::max);
-    report.non_planar_after = after.iter().filter(|&&e| e > options.tolerance).count();
+    report.non_planar_after = after.iter().filter(|&&e| e > tolerance).count();
     report.max_error_after = max_after;
     mesh.set_positions(result);
-    Ok(report)
 }
 
 /// Mean length of the mesh's edges.

@@ -10,7 +10,7 @@ use std::collections::VecDeque;
 
 use serde::Serialize;
 
-use super::build::{build_mesh, BuildError};
+use super::build::{build_mesh, BuildError, BuildReport};
 use super::geometry::diameter;
 use super::halfedge::Mesh;
 use rayon::slice::ParallelSliceMut;
@@ -69,8 +69,58 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
             "the model has no area; check the export",
         ));
     }
+    let (mut polys, mut vertex_source) = drop_unused_vertices(raw, polys, &mut notes);
+
+    let mut welded_facts = None;
+    let tolerance = weld_tolerance(&polys.positions);
+    if raw.welded_corners > 0 {
+        notes.push(Note {
+            kind: "welded-stl",
+            message: format!(
+                "STL triangle corners welded by position (tolerance {tolerance:.3e} model units): {} vertices",
+                raw.polys.positions.len()
+            ),
+        });
+    }
+    if options.weld {
+        (polys, vertex_source) = weld(raw, &polys, &vertex_source, tolerance, &mut notes);
+        welded_facts = Some(soup_facts(&polys));
+    } else {
+        note_shared_positions(raw, &polys, &vertex_source, tolerance, &mut notes);
+    }
+
+    let located = Located {
+        raw,
+        face_source: &face_source,
+        vertex_source: &vertex_source,
+    };
+    let edges = CornerEdges::new(&polys);
+    check_edge_manifold(&polys, &edges, &located)?;
+    orient(&mut polys, &edges, &located, &mut notes)?;
+    drop(edges);
+
+    let (mesh, report) = build_mesh(&polys, Some(&vertex_source), Some(&face_source))
+        .map_err(|e| located.build_error(e))?;
+    note_split_vertices(raw, &report, &mut notes);
+    debug_assert_eq!(mesh.validate(), Ok(()));
+    Ok(PreparedModel {
+        mesh,
+        input,
+        welded: welded_facts,
+        notes,
+        groups: raw.groups.clone(),
+    })
+}
+
+/// Drops the vertices no face uses, with a note naming them; returns the compacted soup
+/// and its map to the file's vertices.
+fn drop_unused_vertices(
+    raw: &RawModel,
+    polys: Polygons,
+    notes: &mut Vec<Note>,
+) -> (Polygons, Vec<u32>) {
     let unused: Vec<u32> = unused_vertices(&polys).collect();
-    let (mut polys, mut vertex_source) = drop_unreferenced(polys, None);
+    let (polys, vertex_source) = drop_unreferenced(polys, None);
     if !unused.is_empty() {
         notes.push(Note {
             kind: "unreferenced-vertices",
@@ -86,89 +136,87 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
             ),
         });
     }
+    (polys, vertex_source)
+}
 
-    let mut welded_facts = None;
-    let tolerance = weld_tolerance(&polys.positions);
-    if raw.welded_corners > 0 {
+/// Merges vertices that share a position where the mesh stays manifold (`--weld`),
+/// with notes on what was merged and what was kept apart; returns the welded soup and
+/// its map to the file's vertices.
+fn weld(
+    raw: &RawModel,
+    polys: &Polygons,
+    vertex_source: &[u32],
+    tolerance: f64,
+    notes: &mut Vec<Note>,
+) -> (Polygons, Vec<u32>) {
+    let (welded, report) = weld_where_manifold(polys, tolerance);
+    let (welded, source) = drop_unreferenced(welded, Some(vertex_source));
+    notes.push(Note {
+        kind: "welded",
+        message: format!(
+            "--weld merged {} vertices that shared a position",
+            report.merged
+        ),
+    });
+    if !report.skipped.is_empty() {
+        let count = report.skipped.len();
         notes.push(Note {
-            kind: "welded-stl",
+            kind: "weld-skipped",
             message: format!(
-                "STL triangle corners welded by position (tolerance {tolerance:.3e} model units): {} vertices",
-                raw.polys.positions.len()
+                "{count} groups of vertices share a position but were kept apart because merging them would make a non-manifold edge or a bow-tie vertex{}",
+                examples(
+                    report.skipped.iter().map(|g| {
+                        let labels: Vec<String> = g
+                            .iter()
+                            .map(|&v| raw.vertex_label(v).to_string())
+                            .collect();
+                        format!("vertices {}", labels.join(" and "))
+                    }),
+                    count
+                )
             ),
         });
     }
-    if options.weld {
-        let (welded, report) = weld_where_manifold(&polys, tolerance);
-        let (welded, source) = drop_unreferenced(welded, Some(&vertex_source));
-        polys = welded;
-        vertex_source = source;
-        welded_facts = Some(soup_facts(&polys));
+    (welded, source)
+}
+
+/// Notes the vertices that repeat another vertex's position, kept apart without
+/// `--weld`.
+fn note_shared_positions(
+    raw: &RawModel,
+    polys: &Polygons,
+    vertex_source: &[u32],
+    tolerance: f64,
+    notes: &mut Vec<Note>,
+) {
+    let clusters = cluster_positions(&polys.positions, tolerance);
+    let repeated: Vec<(u32, u32)> = clusters
+        .iter()
+        .enumerate()
+        .filter(|&(i, &r)| r as usize != i)
+        .map(|(i, &r)| (vertex_source[r as usize], vertex_source[i]))
+        .collect();
+    if !repeated.is_empty() {
         notes.push(Note {
-            kind: "welded",
+            kind: "shared-positions",
             message: format!(
-                "--weld merged {} vertices that shared a position",
-                report.merged
+                "{} vertices repeat the position of another vertex and are kept apart (seams may be intentional; --weld merges them where the mesh stays manifold){}",
+                repeated.len(),
+                examples(
+                    repeated.iter().map(|&(a, b)| format!(
+                        "vertices {} and {}",
+                        raw.vertex_label(a),
+                        raw.vertex_label(b)
+                    )),
+                    repeated.len()
+                )
             ),
         });
-        if !report.skipped.is_empty() {
-            let count = report.skipped.len();
-            notes.push(Note {
-                kind: "weld-skipped",
-                message: format!(
-                    "{count} groups of vertices share a position but were kept apart because merging them would make a non-manifold edge or a bow-tie vertex{}",
-                    examples(
-                        report.skipped.iter().map(|g| {
-                            let labels: Vec<String> = g
-                                .iter()
-                                .map(|&v| raw.vertex_label(v).to_string())
-                                .collect();
-                            format!("vertices {}", labels.join(" and "))
-                        }),
-                        count
-                    )
-                ),
-            });
-        }
-    } else {
-        let clusters = cluster_positions(&polys.positions, tolerance);
-        let repeated: Vec<(u32, u32)> = clusters
-            .iter()
-            .enumerate()
-            .filter(|&(i, &r)| r as usize != i)
-            .map(|(i, &r)| (vertex_source[r as usize], vertex_source[i]))
-            .collect();
-        if !repeated.is_empty() {
-            notes.push(Note {
-                kind: "shared-positions",
-                message: format!(
-                    "{} vertices repeat the position of another vertex and are kept apart (seams may be intentional; --weld merges them where the mesh stays manifold){}",
-                    repeated.len(),
-                    examples(
-                        repeated.iter().map(|&(a, b)| format!(
-                            "vertices {} and {}",
-                            raw.vertex_label(a),
-                            raw.vertex_label(b)
-                        )),
-                        repeated.len()
-                    )
-                ),
-            });
-        }
     }
+}
 
-    let located = Located {
-        raw,
-        face_source: &face_source,
-        vertex_source: &vertex_source,
-    };
-    let edges = CornerEdges::new(&polys);
-    check_edge_manifold(&polys, &edges, &located)?;
-    orient(&mut polys, &edges, &located, &mut notes)?;
-    drop(edges);
-
-    let (mesh, report) = build_mesh(&polys, Some(&vertex_source), Some(&face_source))
-        .map_err(|e| located.build_error(e))?;
+/// Notes the bow-tie vertices the build split into one vertex per fan.
+fn note_split_vertices(raw: &RawModel, report: &BuildReport, notes: &mut Vec<Note>) {
     if !report.split_vertices.is_empty() {
         let count = report.split_vertices.len();
         notes.push(Note {
@@ -185,14 +233,6 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
             ),
         });
     }
-    debug_assert_eq!(mesh.validate(), Ok(()));
-    Ok(PreparedModel {
-        mesh,
-        input,
-        welded: welded_facts,
-        notes,
-        groups: raw.groups.clone(),
-    })
 }
 
 /// Maps soup indices back to the user's file for messages.
@@ -269,109 +309,140 @@ fn examples(items: impl Iterator<Item = String>, total: usize) -> String {
 /// fewer than three distinct corners, pinched faces (a vertex visited twice), faces of
 /// zero area and exact duplicates of an earlier face are dropped and reported.
 fn clean_faces(raw: &RawModel, notes: &mut Vec<Note>) -> (Polygons, Vec<u32>) {
-    let src = &raw.polys;
+    let mut defects = FaceDefects::default();
+    let (out, face_source) = drop_degenerate_faces(&raw.polys, &mut defects);
+    let (out, face_source) = drop_duplicate_faces(out, face_source, &mut defects.duplicates);
+    defects.report(raw, notes);
+    (out, face_source)
+}
+
+/// The faces cleaning changed or dropped, in the file's numbering.
+#[derive(Default)]
+struct FaceDefects {
+    /// Faces that repeated a corner in a row (kept, repeats removed).
+    collapsed: Vec<usize>,
+    /// Faces of fewer than three distinct corners.
+    too_few: Vec<usize>,
+    /// Faces that visit a vertex twice.
+    pinched: Vec<usize>,
+    /// Faces of zero area.
+    zero_area: Vec<usize>,
+    /// Faces that repeat an earlier face, with that earlier face.
+    duplicates: Vec<(usize, u32)>,
+}
+
+/// Collapses repeated consecutive corners of every face and drops the faces left with
+/// fewer than three distinct corners, pinched or of zero area, recording each in
+/// `defects`; returns the kept faces and their indices in the file.
+fn drop_degenerate_faces(src: &Polygons, defects: &mut FaceDefects) -> (Polygons, Vec<u32>) {
     let mut out = Polygons {
         positions: src.positions.clone(),
         ..Polygons::new()
     };
     let mut face_source = Vec::with_capacity(src.face_count());
-    let mut collapsed = Vec::new();
-    let mut too_few = Vec::new();
-    let mut pinched = Vec::new();
-    let mut zero_area = Vec::new();
-    let mut duplicates = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
     let mut sorted: Vec<u32> = Vec::new();
     let mut points = Vec::new();
     for (f, face) in src.faces().enumerate() {
-        corners.clear();
-        for &v in face {
-            if corners.last() != Some(&v) {
-                corners.push(v);
-            }
-        }
-        while corners.len() > 1 && corners.first() == corners.last() {
-            corners.pop();
-        }
+        collapse_repeats(face, &mut corners);
         if corners.len() != face.len() {
-            collapsed.push(f);
+            defects.collapsed.push(f);
         }
         sorted.clear();
         sorted.extend_from_slice(&corners);
         sorted.sort_unstable();
         sorted.dedup();
         if sorted.len() < 3 {
-            too_few.push(f);
+            defects.too_few.push(f);
             continue;
         }
         if sorted.len() != corners.len() {
-            pinched.push(f);
+            defects.pinched.push(f);
             continue;
         }
         points.clear();
         points.extend(corners.iter().map(|&v| src.positions[v as usize]));
         let size = diameter(&points);
         if fan_area(&points) <= 1e-12 * size * size {
-            zero_area.push(f);
+            defects.zero_area.push(f);
             continue;
         }
         out.push_face(&corners);
         face_source.push(f as u32);
     }
-    let (out, face_source) = drop_duplicate_faces(out, face_source, &mut duplicates);
-    let face_name = |f: usize| match raw.face_location(f) {
-        Location::Line(n) => format!("face {f} (line {n})"),
-        Location::Byte(n) => format!("triangle {f} (byte {n})"),
-        Location::File => format!("face {f}"),
-    };
-    let mut report = |kind: &'static str, list: &[usize], what: &str| {
-        if !list.is_empty() {
+    (out, face_source)
+}
+
+/// Writes `face` into `corners` without corners that repeat the one before, the last
+/// corner counting as before the first.
+fn collapse_repeats(face: &[u32], corners: &mut Vec<u32>) {
+    corners.clear();
+    for &v in face {
+        if corners.last() != Some(&v) {
+            corners.push(v);
+        }
+    }
+    while corners.len() > 1 && corners.first() == corners.last() {
+        corners.pop();
+    }
+}
+
+impl FaceDefects {
+    /// Adds one note per kind of defect found, naming the first faces.
+    fn report(&self, raw: &RawModel, notes: &mut Vec<Note>) {
+        let face_name = |f: usize| match raw.face_location(f) {
+            Location::Line(n) => format!("face {f} (line {n})"),
+            Location::Byte(n) => format!("triangle {f} (byte {n})"),
+            Location::File => format!("face {f}"),
+        };
+        let mut report = |kind: &'static str, list: &[usize], what: &str| {
+            if !list.is_empty() {
+                notes.push(Note {
+                    kind,
+                    message: format!(
+                        "{} {what}{}",
+                        list.len(),
+                        examples(list.iter().map(|&f| face_name(f)), list.len())
+                    ),
+                });
+            }
+        };
+        report(
+            "collapsed-corners",
+            &self.collapsed,
+            "faces repeat a corner in a row; the repeats were removed",
+        );
+        report(
+            "degenerate-faces",
+            &self.too_few,
+            "faces have fewer than 3 distinct corners and were dropped",
+        );
+        report(
+            "pinched-faces",
+            &self.pinched,
+            "faces visit a vertex twice (pinched polygons) and were dropped; split them into simple polygons to keep them",
+        );
+        report(
+            "zero-area-faces",
+            &self.zero_area,
+            "faces have zero area and were dropped (the mesh may have a slit there)",
+        );
+        if !self.duplicates.is_empty() {
             notes.push(Note {
-                kind,
+                kind: "duplicate-faces",
                 message: format!(
-                    "{} {what}{}",
-                    list.len(),
-                    examples(list.iter().map(|&f| face_name(f)), list.len())
+                    "{} faces repeat an earlier face's corners and were dropped{}",
+                    self.duplicates.len(),
+                    examples(
+                        self.duplicates
+                            .iter()
+                            .map(|&(f, first)| format!("{} repeats face {first}", face_name(f))),
+                        self.duplicates.len()
+                    )
                 ),
             });
         }
-    };
-    report(
-        "collapsed-corners",
-        &collapsed,
-        "faces repeat a corner in a row; the repeats were removed",
-    );
-    report(
-        "degenerate-faces",
-        &too_few,
-        "faces have fewer than 3 distinct corners and were dropped",
-    );
-    report(
-        "pinched-faces",
-        &pinched,
-        "faces visit a vertex twice (pinched polygons) and were dropped; split them into simple polygons to keep them",
-    );
-    report(
-        "zero-area-faces",
-        &zero_area,
-        "faces have zero area and were dropped (the mesh may have a slit there)",
-    );
-    if !duplicates.is_empty() {
-        notes.push(Note {
-            kind: "duplicate-faces",
-            message: format!(
-                "{} faces repeat an earlier face's corners and were dropped{}",
-                duplicates.len(),
-                examples(
-                    duplicates
-                        .iter()
-                        .map(|&(f, first)| format!("{} repeats face {first}", face_name(f))),
-                    duplicates.len()
-                )
-            ),
-        });
     }
-    (out, face_source)
 }
 
 /// Drops faces with the same set of corners as an earlier face. Faces are sorted by a
@@ -552,64 +623,147 @@ fn orient(
     at: &Located,
     notes: &mut Vec<Note>,
 ) -> Result<(), InputError> {
-    let face_count = polys.face_count();
-    // Neighbours across each shared edge, and whether they run through it the same way
-    // (then exactly one of the two must be flipped), in compressed rows: face f's
-    // neighbours are `pairs[row[f]..row[f + 1]]`.
-    let mut pairs: Vec<(u32, u32, bool)> = Vec::with_capacity(polys.indices.len());
-    for group in edges.groups() {
-        if let [(_, c1), (_, c2)] = *group {
-            let (f1, f2) = (
-                edges.corner_face[c1 as usize],
-                edges.corner_face[c2 as usize],
-            );
-            let same = corner_edge(polys, &edges.corner_face, c1)
-                == corner_edge(polys, &edges.corner_face, c2);
-            pairs.push((f1, f2, same));
-            pairs.push((f2, f1, same));
-        }
-    }
-    pairs.sort_unstable();
-    let mut row = vec![0usize; face_count + 1];
-    for &(f, _, _) in &pairs {
-        row[f as usize + 1] += 1;
-    }
-    for f in 0..face_count {
-        row[f + 1] += row[f];
-    }
-    let neighbours_of = |f: usize| {
-        pairs[row[f]..row[f + 1]]
-            .iter()
-            .map(|&(_, g, same)| (g, same))
-    };
-    let mut flip = vec![false; face_count];
-    let mut component = vec![u32::MAX; face_count];
+    let neighbours = FaceNeighbours::new(polys, edges);
+    let mut walk = ComponentWalk::new(polys.face_count());
     let mut flipped_faces = Vec::new();
     let mut inside_out = Vec::new();
-    let mut queue = VecDeque::new();
-    let mut members = Vec::new();
-    for seed in 0..face_count {
-        if component[seed] != u32::MAX {
+    for seed in 0..polys.face_count() {
+        if walk.component[seed] != u32::MAX {
             continue;
         }
+        let closed = walk.spread(seed, polys, &neighbours, at)?;
+        // Flip the minority so the fewest faces change.
+        let flipped = walk.members.iter().filter(|&&f| walk.flip[f]).count();
+        if 2 * flipped > walk.members.len() {
+            for &f in &walk.members {
+                walk.flip[f] = !walk.flip[f];
+            }
+        }
+        let flipped: Vec<usize> = walk
+            .members
+            .iter()
+            .copied()
+            .filter(|&f| walk.flip[f])
+            .collect();
+        for &f in &flipped {
+            polys.flip_face(f);
+        }
+        flipped_faces.extend(flipped);
+        if closed && signed_volume(polys, &walk.members) < 0.0 {
+            for &f in &walk.members {
+                polys.flip_face(f);
+            }
+            inside_out.push(seed as u32);
+        }
+    }
+    note_orientation(at, flipped_faces, &inside_out, notes);
+    Ok(())
+}
+
+/// The neighbours of every face across its shared edges, and whether each runs through
+/// the edge the same way (then exactly one of the two must be flipped), in compressed
+/// rows: face f's neighbours are `pairs[row[f]..row[f + 1]]`.
+struct FaceNeighbours {
+    /// (face, neighbour, same direction), sorted by face.
+    pairs: Vec<(u32, u32, bool)>,
+    /// Where each face's run of `pairs` starts, plus a final end.
+    row: Vec<usize>,
+}
+
+impl FaceNeighbours {
+    /// The neighbours across every edge shared by two faces.
+    fn new(polys: &Polygons, edges: &CornerEdges) -> Self {
+        let face_count = polys.face_count();
+        let mut pairs: Vec<(u32, u32, bool)> = Vec::with_capacity(polys.indices.len());
+        for group in edges.groups() {
+            if let [(_, c1), (_, c2)] = *group {
+                let (f1, f2) = (
+                    edges.corner_face[c1 as usize],
+                    edges.corner_face[c2 as usize],
+                );
+                let same = corner_edge(polys, &edges.corner_face, c1)
+                    == corner_edge(polys, &edges.corner_face, c2);
+                pairs.push((f1, f2, same));
+                pairs.push((f2, f1, same));
+            }
+        }
+        pairs.sort_unstable();
+        let mut row = vec![0usize; face_count + 1];
+        for &(f, _, _) in &pairs {
+            row[f as usize + 1] += 1;
+        }
+        for f in 0..face_count {
+            row[f + 1] += row[f];
+        }
+        FaceNeighbours { pairs, row }
+    }
+
+    /// The neighbours of face `f`, each with whether it runs the same way through the
+    /// shared edge.
+    fn of(&self, f: usize) -> impl Iterator<Item = (u32, bool)> + '_ {
+        self.pairs[self.row[f]..self.row[f + 1]]
+            .iter()
+            .map(|&(_, g, same)| (g, same))
+    }
+
+    /// How many neighbours face `f` has.
+    fn count(&self, f: usize) -> usize {
+        self.row[f + 1] - self.row[f]
+    }
+}
+
+/// A breadth-first walk over the faces, one component at a time, deciding which faces
+/// to flip.
+struct ComponentWalk {
+    /// Whether each face is to be flipped.
+    flip: Vec<bool>,
+    /// The component of each face (its seed), `u32::MAX` before it is reached.
+    component: Vec<u32>,
+    /// Faces reached but not yet visited.
+    queue: VecDeque<usize>,
+    /// The faces of the current component, in visiting order.
+    members: Vec<usize>,
+}
+
+impl ComponentWalk {
+    /// A walk over `face_count` faces, none reached yet.
+    fn new(face_count: usize) -> Self {
+        ComponentWalk {
+            flip: vec![false; face_count],
+            component: vec![u32::MAX; face_count],
+            queue: VecDeque::new(),
+            members: Vec::new(),
+        }
+    }
+
+    /// Visits the component of `seed`, setting `flip` so that its faces agree with the
+    /// seed and filling `members`; returns whether the component is closed. Rejects a
+    /// non-orientable component.
+    fn spread(
+        &mut self,
+        seed: usize,
+        polys: &Polygons,
+        neighbours: &FaceNeighbours,
+        at: &Located,
+    ) -> Result<bool, InputError> {
         let id = seed as u32;
-        component[seed] = id;
-        members.clear();
-        queue.push_back(seed);
+        self.component[seed] = id;
+        self.members.clear();
+        self.queue.push_back(seed);
         let mut closed = true;
-        while let Some(f) = queue.pop_front() {
-            members.push(f);
-            if row[f + 1] - row[f] < polys.face(f).len() {
+        while let Some(f) = self.queue.pop_front() {
+            self.members.push(f);
+            if neighbours.count(f) < polys.face(f).len() {
                 closed = false;
             }
-            for (g, same) in neighbours_of(f) {
-                let want = flip[f] ^ same;
+            for (g, same) in neighbours.of(f) {
+                let want = self.flip[f] ^ same;
                 let g = g as usize;
-                if component[g] == u32::MAX {
-                    component[g] = id;
-                    flip[g] = want;
-                    queue.push_back(g);
-                } else if flip[g] != want {
+                if self.component[g] == u32::MAX {
+                    self.component[g] = id;
+                    self.flip[g] = want;
+                    self.queue.push_back(g);
+                } else if self.flip[g] != want {
                     return Err(at.error(
                         seed as u32,
                         format!(
@@ -621,25 +775,18 @@ fn orient(
                 }
             }
         }
-        // Flip the minority so the fewest faces change.
-        let flipped = members.iter().filter(|&&f| flip[f]).count();
-        if 2 * flipped > members.len() {
-            for &f in &members {
-                flip[f] = !flip[f];
-            }
-        }
-        let flipped: Vec<usize> = members.iter().copied().filter(|&f| flip[f]).collect();
-        for &f in &flipped {
-            polys.flip_face(f);
-        }
-        flipped_faces.extend(flipped);
-        if closed && signed_volume(polys, &members) < 0.0 {
-            for &f in &members {
-                polys.flip_face(f);
-            }
-            inside_out.push(seed as u32);
-        }
+        Ok(closed)
     }
+}
+
+/// Notes the faces flipped to agree with their neighbours and the closed parts turned
+/// outward (each named by its first face).
+fn note_orientation(
+    at: &Located,
+    mut flipped_faces: Vec<usize>,
+    inside_out: &[u32],
+    notes: &mut Vec<Note>,
+) {
     if !flipped_faces.is_empty() {
         flipped_faces.sort_unstable();
         notes.push(Note {
@@ -669,7 +816,6 @@ fn orient(
             ),
         });
     }
-    Ok(())
 }
 
 /// Six times the volume enclosed by the faces (divergence theorem over fan triangles).

@@ -44,6 +44,15 @@ impl Mesh {
     /// Checks every connectivity invariant: sizes, then index ranges, then every loop
     /// with a step limit, then vertex fans. O(n); meant for tests and debug builds.
     pub fn validate(&self) -> Result<(), ConnectivityError> {
+        self.check_sizes()?;
+        self.check_ranges()?;
+        self.check_half_edge_links()?;
+        self.check_face_loops()?;
+        self.check_vertex_fans()
+    }
+
+    /// Checks that the tables agree in length and that half-edges come in pairs.
+    fn check_sizes(&self) -> Result<(), ConnectivityError> {
         use ConnectivityError as E;
         let nh = self.half_edge_count();
         let (nv, nf) = (self.vertex_count(), self.face_count());
@@ -62,7 +71,14 @@ impl Mesh {
         if self.face_source.len() != nf {
             return Err(E::Sizes("face tables"));
         }
-        let out_of_range = |what, at: String| Err(E::OutOfRange { what, at });
+        Ok(())
+    }
+
+    /// Checks that every stored handle points into its table.
+    fn check_ranges(&self) -> Result<(), ConnectivityError> {
+        let nh = self.half_edge_count();
+        let (nv, nf) = (self.vertex_count(), self.face_count());
+        let out_of_range = |what, at: String| Err(ConnectivityError::OutOfRange { what, at });
         for h in self.half_edges() {
             let i = h.index();
             if self.half_edge_next[i].index() >= nh {
@@ -89,7 +105,13 @@ impl Mesh {
                 return out_of_range("half-edge", f.to_string());
             }
         }
+        Ok(())
+    }
 
+    /// Checks that next and prev are inverse, that half-edges join head to tail, and
+    /// that every edge has a face on at least one side.
+    fn check_half_edge_links(&self) -> Result<(), ConnectivityError> {
+        use ConnectivityError as E;
         for h in self.half_edges() {
             if self.prev(self.next(h)) != h || self.next(self.prev(h)) != h {
                 return Err(E::NextPrev(h));
@@ -101,7 +123,14 @@ impl Mesh {
                 return Err(E::FacelessEdge(h));
             }
         }
+        Ok(())
+    }
 
+    /// Checks that every face loop closes on itself, within the half-edge count, and
+    /// has at least three corners.
+    fn check_face_loops(&self) -> Result<(), ConnectivityError> {
+        use ConnectivityError as E;
+        let nh = self.half_edge_count();
         for f in self.faces() {
             let start = self.face_half_edge(f);
             let mut h = start;
@@ -123,9 +152,14 @@ impl Mesh {
                 return Err(E::DegenerateFace(f));
             }
         }
+        Ok(())
+    }
 
-        // Every outgoing half-edge of a vertex must be reached by turning around it from
-        // its stored half-edge; a boundary vertex must store its boundary half-edge.
+    /// Checks that turning around each vertex from its stored half-edge reaches all its
+    /// outgoing half-edges, and that a boundary vertex stores its boundary half-edge.
+    fn check_vertex_fans(&self) -> Result<(), ConnectivityError> {
+        use ConnectivityError as E;
+        let nv = self.vertex_count();
         let mut outgoing = vec![0u32; nv];
         let mut boundary_out = vec![0u32; nv];
         for h in self.half_edges() {

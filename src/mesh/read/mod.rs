@@ -12,6 +12,8 @@ mod stl;
 
 use std::path::{Path, PathBuf};
 
+use glam::DVec3;
+
 use crate::error::{InputError, Location};
 
 use super::polygons::Polygons;
@@ -95,6 +97,20 @@ impl RawModel {
     /// A vertex index as the user's file writes it (1-based in OBJ).
     pub fn vertex_label(&self, v: u32) -> u64 {
         v as u64 + self.format.index_base() as u64
+    }
+
+    /// A model read from a text file, with no groups and nothing ignored.
+    fn text(path: &Path, format: Format, polys: Polygons, face_locations: Vec<u64>) -> Self {
+        RawModel {
+            path: path.to_path_buf(),
+            format,
+            polys,
+            face_locations,
+            binary: false,
+            groups: Vec::new(),
+            ignored: Vec::new(),
+            welded_corners: 0,
+        }
     }
 }
 
@@ -291,4 +307,43 @@ pub(crate) fn parse_coordinate(
             "fix the number or export the model again",
         )),
     }
+}
+
+/// What to do when a text file stops before the data it announced.
+const TRUNCATED_FIX: &str = "the file may be truncated; export it again";
+
+/// What to do when a face names a vertex the file does not have.
+const BAD_INDEX_FIX: &str = "fix the face or export the model again";
+
+/// An input error at a line of a text model file.
+fn line_error(
+    path: &Path,
+    line: u64,
+    problem: impl Into<String>,
+    fix: impl Into<String>,
+) -> InputError {
+    InputError::new(path, Location::Line(line), problem, fix)
+}
+
+/// Reads the x, y and z of a vertex from a line's next three tokens; `fix` says how
+/// the format writes a vertex when a coordinate is missing.
+fn parse_position<'t>(
+    path: &Path,
+    line: u64,
+    tokens: &mut impl Iterator<Item = &'t str>,
+    fix: &str,
+) -> Result<DVec3, InputError> {
+    let mut xyz = [0.0; 3];
+    for (axis, slot) in xyz.iter_mut().enumerate() {
+        let Some(token) = tokens.next() else {
+            return Err(line_error(
+                path,
+                line,
+                format!("vertex has {axis} coordinates; it needs x, y and z"),
+                fix,
+            ));
+        };
+        *slot = parse_coordinate(path, line, token, "vertex")?;
+    }
+    Ok(DVec3::from_array(xyz))
 }
