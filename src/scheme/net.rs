@@ -1371,18 +1371,46 @@ mod tests {
         build_from_faces(p, &faces).unwrap()
     }
 
-    /// A flat grid of `cols` × `rows` squares in z = 0, faces row by row.
-    fn grid(cols: u32, rows: u32) -> Mesh {
-        let v = |c: u32, r: u32| r * (cols + 1) + c;
-        let p = (0..=rows)
-            .flat_map(|r| (0..=cols).map(move |c| SIDE * DVec3::new(c as f64, r as f64, 0.0)))
-            .collect();
-        let faces: Vec<[u32; 4]> = (0..rows)
-            .flat_map(|r| {
-                (0..cols).map(move |c| [v(c, r), v(c + 1, r), v(c + 1, r + 1), v(c, r + 1)])
+    /// Flat squares of side [`SIDE`] in z = 0, face k on cell `cells[k]` (column, row).
+    fn squares(cells: &[(u32, u32)]) -> Mesh {
+        let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut p = Vec::new();
+        let mut corner = |c: u32, r: u32| {
+            *index.entry((c, r)).or_insert_with(|| {
+                p.push(SIDE * DVec3::new(f64::from(c), f64::from(r), 0.0));
+                (p.len() - 1) as u32
+            })
+        };
+        let faces: Vec<[u32; 4]> = cells
+            .iter()
+            .map(|&(c, r)| {
+                [
+                    corner(c, r),
+                    corner(c + 1, r),
+                    corner(c + 1, r + 1),
+                    corner(c, r + 1),
+                ]
             })
             .collect();
         build_from_faces(p, &faces).unwrap()
+    }
+
+    /// A flat grid of `cols` × `rows` squares, faces row by row.
+    fn grid(cols: u32, rows: u32) -> Mesh {
+        let cells: Vec<(u32, u32)> = (0..rows)
+            .flat_map(|r| (0..cols).map(move |c| (c, r)))
+            .collect();
+        squares(&cells)
+    }
+
+    /// A flat L: faces 0 to 6 in a row along x, faces 7 to 15 in a column up from
+    /// face 0.
+    fn ell() -> Mesh {
+        let cells: Vec<(u32, u32)> = (0..7)
+            .map(|c| (c, 0))
+            .chain((1..10).map(|r| (0, r)))
+            .collect();
+        squares(&cells)
     }
 
     /// Two squares side by side in z = 0 (faces 0 and 1, flat across edge 1) and a
@@ -1459,6 +1487,27 @@ mod tests {
         // Without the cap the 90° edge folds too, as the join completes the part.
         let out = panels(&mesh, &options(None));
         assert_eq!(out.islands, vec![vec![0, 1, 2]]);
+        assert_eq!(out.connections, 0);
+    }
+
+    #[test]
+    fn a_sprawling_join_waits_unless_it_completes_the_part() {
+        let mesh = ell();
+        // Edge ids follow the faces, so the row joins first, with face 7 (above face
+        // 0): hull (0,0), (7,0), (7,1), (1,2), (0,2) in sides, area 11 over 8 faces,
+        // 1.375 ≤ 1.5. Face 8 would make it (0,0), (7,0), (7,1), (1,3), (0,3), area 15
+        // over 9 faces, 1.67 > 1.5: faces 8 to 15 grow a second island, and 8 + 8
+        // faces pass the cap of 15.
+        let out = panels(&mesh, &options(Some(15)));
+        assert_eq!(
+            out.islands,
+            vec![(0..8).collect::<Vec<u32>>(), (8..16).collect()]
+        );
+        assert_eq!(out.connections, 1);
+        // Uncapped, joining the two makes the whole part one island: made whatever its
+        // shape.
+        let out = panels(&mesh, &options(None));
+        assert_eq!(out.islands, vec![(0..16).collect::<Vec<u32>>()]);
         assert_eq!(out.connections, 0);
     }
 
