@@ -375,3 +375,177 @@ pub(crate) fn tetrahedron() -> Mesh {
     ];
     build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
 }
+
+/// Two triangles hinged on the edge (0,0,0)–(60,0,0) mm, for the schemes' unit tests:
+/// face 0 is (0,0,0), (30,−30,0), (60,0,0) in z = 0 (normal +z), face 1 is (0,0,0),
+/// (60,0,0), `apex`. The hinge is edge 2 (half-edge 4 runs (60,0,0) → (0,0,0) in face
+/// 0, half-edge 5 the other way in face 1); edges 0, 1, 3 and 4 are boundary edges.
+#[cfg(test)]
+pub(crate) fn two_triangles(apex: DVec3) -> Mesh {
+    let p = vec![
+        DVec3::ZERO,
+        DVec3::new(60.0, 0.0, 0.0),
+        DVec3::new(30.0, -30.0, 0.0),
+        apex,
+    ];
+    build_from_faces(p, &[[0u32, 2, 1], [0, 1, 3]]).unwrap()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::EdgeId;
+
+    /// `count` points on the parabola y = x² in z = 0 (no three in a line).
+    fn points(count: usize) -> Vec<DVec3> {
+        (0..count)
+            .map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0))
+            .collect()
+    }
+
+    /// The error `build_mesh` gives for these faces over `count` points.
+    fn error_of(count: usize, faces: &[&[u32]]) -> BuildError {
+        build_from_faces(points(count), faces).unwrap_err()
+    }
+
+    #[test]
+    fn a_face_of_two_corners_is_refused() {
+        assert_eq!(
+            error_of(4, &[&[0, 1, 2], &[2, 3]]),
+            BuildError::TooFewCorners {
+                face: 1,
+                corners: 2
+            }
+        );
+    }
+
+    #[test]
+    fn a_corner_past_the_last_vertex_is_refused() {
+        assert_eq!(
+            error_of(4, &[&[0, 1, 9]]),
+            BuildError::IndexOutOfRange {
+                face: 0,
+                vertex: 9,
+                count: 4
+            }
+        );
+    }
+
+    #[test]
+    fn a_face_visiting_a_vertex_twice_is_refused() {
+        // Corners 1 and 3 of face 1 are both vertex 2.
+        assert_eq!(
+            error_of(5, &[&[0, 1, 2], &[1, 2, 3, 2, 4]]),
+            BuildError::RepeatedVertex { face: 1, vertex: 2 }
+        );
+    }
+
+    #[test]
+    fn an_edge_of_three_faces_is_refused_naming_all_three() {
+        // Edge 0–1 in faces 0, 1 and 2 (whatever their directions).
+        assert_eq!(
+            error_of(5, &[&[0, 1, 2], &[1, 0, 3], &[0, 1, 4]]),
+            BuildError::NonManifoldEdge {
+                a: 0,
+                b: 1,
+                faces: vec![0, 1, 2]
+            }
+        );
+    }
+
+    #[test]
+    fn two_faces_running_an_edge_the_same_way_are_refused() {
+        // Both faces run 0 → 1.
+        assert_eq!(
+            error_of(4, &[&[0, 1, 2], &[0, 1, 3]]),
+            BuildError::InconsistentOrientation {
+                a: 0,
+                b: 1,
+                faces: [0, 1]
+            }
+        );
+    }
+
+    #[test]
+    fn a_vertex_no_face_uses_is_refused() {
+        assert_eq!(
+            error_of(4, &[&[0, 1, 2]]),
+            BuildError::IsolatedVertex { vertex: 3 }
+        );
+    }
+
+    #[test]
+    fn a_face_of_collinear_corners_still_builds() {
+        // The builder judges topology only: a zero-area face is the validator's business.
+        let p = vec![DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
+        let mesh = build_from_faces(p, &[[0u32, 1, 2]]).unwrap();
+        assert_eq!((mesh.face_count(), mesh.edge_count()), (1, 3));
+        assert_eq!(mesh.face_area(crate::mesh::FaceId(0)), 0.0);
+    }
+
+    #[test]
+    fn a_bow_tie_vertex_is_split_and_reported_in_the_users_numbering() {
+        // Two triangles meeting only at vertex 0: two fans there.
+        let polys = Polygons::from_faces(points(5), &[[0u32, 1, 2], [0, 3, 4]]);
+        let source = [10, 11, 12, 13, 14];
+        let (mesh, report) = build_mesh(&polys, Some(&source), Some(&[7, 8])).unwrap();
+        assert_eq!(report.split_vertices, vec![(10, 2)]);
+        // The second fan gets vertex 5, at vertex 0's place and from its source.
+        assert_eq!(mesh.vertex_count(), 6);
+        assert_eq!(mesh.positions()[5], mesh.positions()[0]);
+        assert_eq!(mesh.vertex_source(VertexId(5)), 10);
+        assert_eq!(
+            mesh.face_vertices(crate::mesh::FaceId(1))
+                .map(|v| v.0)
+                .collect::<Vec<_>>(),
+            vec![5, 3, 4]
+        );
+        assert_eq!(mesh.face_source(crate::mesh::FaceId(1)), 8);
+    }
+
+    #[test]
+    fn a_manifold_soup_reports_no_repair() {
+        let polys = Polygons::from_faces(points(4), &[[0u32, 1, 2], [0, 2, 3]]);
+        let (mesh, report) = build_mesh(&polys, None, None).unwrap();
+        assert_eq!(report, BuildReport::default());
+        // 5 edges: 4 on the boundary and the diagonal 0–2; V − E + F = 4 − 5 + 2 = 1.
+        assert_eq!((mesh.vertex_count(), mesh.edge_count()), (4, 5));
+    }
+
+    #[test]
+    fn edges_are_numbered_in_face_order_with_the_first_face_on_the_even_half_edge() {
+        let mesh = two_triangles(DVec3::new(30.0, 30.0, 0.0));
+        // Corners in file order: 0→2, 2→1, 1→0 (face 0), 0→1, 1→3, 3→0 (face 1).
+        let ends: Vec<(u32, u32)> = mesh
+            .edges()
+            .map(|e| {
+                let h = e.half_edge();
+                (mesh.origin(h).0, mesh.dest(h).0)
+            })
+            .collect();
+        assert_eq!(ends, vec![(0, 2), (2, 1), (1, 0), (1, 3), (3, 0)]);
+        // Only edge 2 has a face on both sides; the twin of every other is a boundary.
+        let interior: Vec<u32> = mesh
+            .edges()
+            .filter(|&e| !mesh.is_boundary_edge(e))
+            .map(|e| e.0)
+            .collect();
+        assert_eq!(interior, vec![2]);
+        assert!(mesh.is_boundary_half_edge(EdgeId(0).half_edge().twin()));
+        // The boundary loop runs round both faces: 4 half-edges, each the twin of a
+        // boundary edge's face half-edge.
+        assert_eq!(mesh.boundary_loops().len(), 1);
+        assert_eq!(mesh.loop_from(mesh.boundary_loops()[0]).count(), 4);
+    }
+
+    #[test]
+    fn the_tetrahedron_fixture_is_closed() {
+        let mesh = tetrahedron();
+        // V − E + F = 4 − 6 + 4 = 2, no boundary.
+        assert_eq!(
+            (mesh.vertex_count(), mesh.edge_count(), mesh.face_count()),
+            (4, 6, 4)
+        );
+        assert!(mesh.edges().all(|e| !mesh.is_boundary_edge(e)));
+    }
+}

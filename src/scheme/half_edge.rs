@@ -560,3 +560,231 @@ fn place_holes(
         .find_map(|n| along(n).map(|centres| (centres, n < count)))
         .unwrap_or((Vec::new(), true))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::build::{tetrahedron, two_triangles};
+
+    /// Face 1 of [`two_triangles`] with its centre 40 mm from the hinge: high enough
+    /// for a full tab of a few mm.
+    const TALL: DVec3 = DVec3::new(30.0, 120.0, 0.0);
+
+    /// Options with faces shrunk by `face_scale`, `holes` holes of 1 mm with 0.5 mm of
+    /// margin per tab, and tabs `tab_height` high.
+    fn options(face_scale: f64, holes: u32, tab_height: f64) -> HalfEdgeOptions {
+        HalfEdgeOptions {
+            panel: PanelOptions {
+                face_scale,
+                holes,
+                hole_diameter: 1.0,
+                hole_margin: 0.5,
+                label_height: 2.0,
+                panel_limit: None,
+            },
+            tabs: true,
+            tab_height,
+        }
+    }
+
+    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
+    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
+        assert_eq!(actual.len(), expected.len(), "{actual:?}");
+        for (p, q) in actual.iter().zip(expected) {
+            assert!(
+                p.distance(DVec3::from(*q)) < 1e-9,
+                "{actual:?} is not {expected:?}"
+            );
+        }
+    }
+
+    /// The tab face 0 of `two_triangles(apex)` folds onto face 1 across the hinge.
+    fn hinge_tab(apex: DVec3, options: &HalfEdgeOptions) -> Option<Tab> {
+        make_tab(&two_triangles(apex), HalfedgeId(4), options)
+    }
+
+    #[test]
+    fn a_tab_is_a_trapezoid_of_the_wanted_height_inset_from_the_corners() {
+        let tab = hinge_tab(TALL, &options(1.0, 0, 4.0)).unwrap();
+        assert_eq!(tab.owner, HalfedgeId(4));
+        // Half-edge 4 runs a = (60,0,0) → b = (0,0,0); the base is inset min(5% of 60,
+        // 0.5) = 0.5 mm from each end.
+        assert_points(&tab.base, &[[59.5, 0.0, 0.0], [0.5, 0.0, 0.0]]);
+        // 45° sides: the top at y = 4 runs from x = 0.5 + 4 to x = 59.5 − 4, listed
+        // after a' (so from the a end).
+        assert_points(&tab.top, &[[55.5, 4.0, 0.0], [4.5, 4.0, 0.0]]);
+        assert!(!tab.shortened && !tab.holes_skipped && tab.holes.is_empty());
+    }
+
+    #[test]
+    fn a_tab_stays_inside_the_triangle_of_the_edge_and_the_neighbour_centre() {
+        // Face 1's centre is (30,10,0): the sector's sides y = x/3 and y = (60 − x)/3
+        // cut the trapezoid's sides x = 0.5 + y and x = 59.5 − y at y = 0.25, and its
+        // top y = 4 at x = 12 and x = 48.
+        let tab = hinge_tab(DVec3::new(30.0, 30.0, 0.0), &options(1.0, 0, 4.0)).unwrap();
+        assert_points(&tab.base, &[[59.5, 0.0, 0.0], [0.5, 0.0, 0.0]]);
+        assert_points(
+            &tab.top,
+            &[
+                [59.25, 0.25, 0.0],
+                [48.0, 4.0, 0.0],
+                [12.0, 4.0, 0.0],
+                [0.75, 0.25, 0.0],
+            ],
+        );
+        // Its full height is still reached.
+        assert!(!tab.shortened);
+    }
+
+    #[test]
+    fn a_tab_higher_than_half_its_base_is_a_shortened_triangle() {
+        // 40 mm wanted over a 59 mm base: the 45° sides meet at x = 30, y = 59/2.
+        let tab = hinge_tab(TALL, &options(1.0, 0, 40.0)).unwrap();
+        assert_points(&tab.top, &[[30.0, 29.5, 0.0]]);
+        assert!(tab.shortened);
+    }
+
+    #[test]
+    fn no_tab_onto_a_neighbour_too_small_to_hold_one() {
+        // A neighbour 0.3 mm high: its centre is 0.1 mm from the hinge, and a tab
+        // overlapping it by less than min(4/2, 1) = 1 mm is no tab.
+        assert!(hinge_tab(DVec3::new(30.0, 0.3, 0.0), &options(1.0, 0, 4.0)).is_none());
+        // Nor across a boundary edge (edge 0's twin has no face).
+        let mesh = two_triangles(TALL);
+        assert!(make_tab(&mesh, HalfedgeId(0), &options(1.0, 0, 4.0)).is_none());
+    }
+
+    #[test]
+    fn holes_lie_evenly_along_the_middle_of_the_overlap() {
+        // The overlap's middle is y = 4/2 = 2, where the tab runs from x = 2.5 to
+        // 57.5: two holes at 1/3 and 2/3 of that, 55/3 mm apart, from the a end.
+        let tab = hinge_tab(TALL, &options(1.0, 2, 4.0)).unwrap();
+        let third = 55.0 / 3.0;
+        assert_points(
+            &tab.holes,
+            &[[57.5 - third, 2.0, 0.0], [57.5 - 2.0 * third, 2.0, 0.0]],
+        );
+        assert!(!tab.holes_skipped);
+    }
+
+    #[test]
+    fn a_hole_without_its_margin_in_the_tab_is_left_out_and_reported() {
+        // Radius 1.5 + margin 1 = 2.5 mm from every cut edge, but the 4 mm tab's middle
+        // is 2 mm from its base and top.
+        let mut options = options(1.0, 1, 4.0);
+        options.panel.hole_diameter = 3.0;
+        options.panel.hole_margin = 1.0;
+        let tab = hinge_tab(TALL, &options).unwrap();
+        assert!(tab.holes.is_empty() && tab.holes_skipped);
+        let out = panels(&two_triangles(TALL), &options);
+        let unfastened: Vec<String> = out.unfastened.iter().map(|c| c.to_string()).collect();
+        assert_eq!(unfastened, ["F0/F1 at E2"]);
+    }
+
+    #[test]
+    fn whole_faces_carry_their_tab_on_the_hinge_and_share_its_holes() {
+        let out = panels(&two_triangles(TALL), &options(1.0, 1, 4.0));
+        // One panel per face, one connection for the one interior edge.
+        assert_eq!((out.panels.len(), out.connections), (2, 1));
+        assert!(out.notes.is_empty(), "{:?}", out.notes);
+        let (owner, partner) = (out.panels.get(0), out.panels.get(1));
+        assert_eq!(
+            (owner.id().to_string(), partner.id().to_string()),
+            ("F0".to_string(), "F1".to_string())
+        );
+        // Face 0's corners (0,0,0), (30,−30,0), (60,0,0), whole (face scale 1); then
+        // the tab's base a', b' and its top.
+        assert_points(
+            owner.vertices,
+            &[
+                [0.0, 0.0, 0.0],
+                [30.0, -30.0, 0.0],
+                [60.0, 0.0, 0.0],
+                [59.5, 0.0, 0.0],
+                [0.5, 0.0, 0.0],
+                [55.5, 4.0, 0.0],
+                [4.5, 4.0, 0.0],
+            ],
+        );
+        // The band runs through the tab's base, so the tab hinges on the face edge.
+        let facets: Vec<Vec<u32>> = owner.facets.iter().map(<[u32]>::to_vec).collect();
+        assert_eq!(facets, vec![vec![0, 1, 2, 3, 4], vec![4, 3, 5, 6]]);
+        let facets: Vec<Vec<u32>> = partner.facets.iter().map(<[u32]>::to_vec).collect();
+        assert_eq!(facets, vec![vec![0, 1, 2]]);
+        // The one hole, at (30, 2, 0) (the middle of 2.5…57.5 at y = 2), goes through
+        // the tab (facet 1) and the neighbour's band (facet 0) at the same point.
+        for (panel, facet) in [(owner, 1), (partner, 0)] {
+            assert_eq!(panel.holes.len(), 1);
+            let hole = &panel.holes[0];
+            assert_points(&[hole.position], &[[30.0, 2.0, 0.0]]);
+            assert_eq!(
+                (hole.connection, hole.facet, hole.diameter),
+                (2, facet, 1.0)
+            );
+        }
+        // The owner names its partner along the hinge.
+        let partners: Vec<Name> = owner
+            .labels
+            .iter()
+            .filter(|l| l.kind == LabelKind::Partner)
+            .map(|l| l.text)
+            .collect();
+        assert_eq!(partners, vec![Name::face(1)]);
+    }
+
+    #[test]
+    fn a_shrunk_face_bridges_the_gap_to_its_tab() {
+        let out = panels(&two_triangles(TALL), &options(0.5, 0, 4.0));
+        let owner = out.panels.get(0);
+        // Face 0's centre is (30,−10,0): each corner moves halfway to it. The gap to
+        // face 1's band is half its centre's 40 mm height, so the tab rises 20 + 4 mm,
+        // its 45° top from x = 0.5 + 24 to 59.5 − 24.
+        assert_points(
+            owner.vertices,
+            &[
+                [15.0, -5.0, 0.0],
+                [30.0, -20.0, 0.0],
+                [45.0, -5.0, 0.0],
+                [59.5, 0.0, 0.0],
+                [0.5, 0.0, 0.0],
+                [60.0, 0.0, 0.0],
+                [0.0, 0.0, 0.0],
+                [35.5, 24.0, 0.0],
+                [24.5, 24.0, 0.0],
+            ],
+        );
+        // Band, then the bridge from band edge (45,−5)–(15,−5) to the mesh edge
+        // through the tab's base, then the tab.
+        let facets: Vec<Vec<u32>> = owner.facets.iter().map(<[u32]>::to_vec).collect();
+        assert_eq!(
+            facets,
+            vec![vec![0, 1, 2], vec![0, 2, 5, 3, 4, 6], vec![4, 3, 7, 8]]
+        );
+        assert!(out.notes.is_empty(), "{:?}", out.notes);
+    }
+
+    #[test]
+    fn a_closed_mesh_has_a_panel_per_face_and_a_tab_per_edge() {
+        let mut mesh = tetrahedron();
+        // Edges 2√2·20 ≈ 56.6 mm: each face's centre is 56.6/(2√3) ≈ 16.3 mm from its
+        // edges, room for a full 8 mm tab.
+        mesh.scale(20.0);
+        let out = panels(&mesh, &options(1.0, 0, 8.0));
+        assert_eq!((out.panels.len(), out.connections), (4, 6));
+        assert!(out.notes.is_empty(), "{:?}", out.notes);
+        let ids: Vec<String> = out.panels.iter().map(|p| p.id().to_string()).collect();
+        assert_eq!(ids, ["F0", "F1", "F2", "F3"]);
+        // Each panel is its band and one facet per tab it owns: 4 + 6 facets.
+        let facets: usize = out.panels.iter().map(|p| p.facets.len()).sum();
+        assert_eq!(facets, 10);
+    }
+
+    #[test]
+    fn connectors_none_makes_bare_faces() {
+        let mut options = options(1.0, 0, 8.0);
+        options.tabs = false;
+        let out = panels(&two_triangles(TALL), &options);
+        assert_eq!(out.connections, 0);
+        assert!(out.panels.iter().all(|p| p.facets.len() == 1));
+    }
+}

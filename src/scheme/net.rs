@@ -1401,3 +1401,287 @@ impl Summary {
         params
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::build_from_faces;
+
+    /// Squares 40 mm on a side: room for a full 5 mm tab on every edge.
+    const SIDE: f64 = 40.0;
+
+    /// Net options: whole faces, no holes, 5 mm tabs, at most `max_island_faces` faces
+    /// an island, folds under 1° unscored, the default spread, no sheet limit.
+    fn options(max_island_faces: Option<usize>) -> NetOptions {
+        NetOptions {
+            panel: PanelOptions {
+                face_scale: 1.0,
+                holes: 0,
+                hole_diameter: 1.0,
+                hole_margin: 0.5,
+                label_height: 2.0,
+                panel_limit: None,
+            },
+            tab_height: 5.0,
+            max_island_faces,
+            flat_fold: 1f64.to_radians(),
+            island_spread: ISLAND_SPREAD,
+        }
+    }
+
+    /// A closed cube of side [`SIDE`], faces bottom, top, front, back, left, right.
+    fn cube() -> Mesh {
+        let p = (0..8)
+            .map(|i| SIDE * DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+            .collect();
+        let faces = [
+            [0u32, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [3, 2, 6, 7],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ];
+        build_from_faces(p, &faces).unwrap()
+    }
+
+    /// Flat squares of side [`SIDE`] in z = 0, face k on cell `cells[k]` (column, row).
+    fn squares(cells: &[(u32, u32)]) -> Mesh {
+        let mut index: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut p = Vec::new();
+        let mut corner = |c: u32, r: u32| {
+            *index.entry((c, r)).or_insert_with(|| {
+                p.push(SIDE * DVec3::new(f64::from(c), f64::from(r), 0.0));
+                (p.len() - 1) as u32
+            })
+        };
+        let faces: Vec<[u32; 4]> = cells
+            .iter()
+            .map(|&(c, r)| {
+                [
+                    corner(c, r),
+                    corner(c + 1, r),
+                    corner(c + 1, r + 1),
+                    corner(c, r + 1),
+                ]
+            })
+            .collect();
+        build_from_faces(p, &faces).unwrap()
+    }
+
+    /// A flat grid of `cols` × `rows` squares, faces row by row.
+    fn grid(cols: u32, rows: u32) -> Mesh {
+        let cells: Vec<(u32, u32)> = (0..rows)
+            .flat_map(|r| (0..cols).map(move |c| (c, r)))
+            .collect();
+        squares(&cells)
+    }
+
+    /// A flat L: faces 0 to 6 in a row along x, faces 7 to 15 in a column up from
+    /// face 0.
+    fn ell() -> Mesh {
+        let cells: Vec<(u32, u32)> = (0..7)
+            .map(|c| (c, 0))
+            .chain((1..10).map(|r| (0, r)))
+            .collect();
+        squares(&cells)
+    }
+
+    /// Two squares side by side in z = 0 (faces 0 and 1, flat across edge 1) and a
+    /// third standing up from face 1's far side (face 2, at 90° across edge 5).
+    fn step() -> Mesh {
+        let s = SIDE;
+        let p = vec![
+            DVec3::ZERO,
+            DVec3::new(s, 0.0, 0.0),
+            DVec3::new(2.0 * s, 0.0, 0.0),
+            DVec3::new(0.0, s, 0.0),
+            DVec3::new(s, s, 0.0),
+            DVec3::new(2.0 * s, s, 0.0),
+            DVec3::new(2.0 * s, 0.0, s),
+            DVec3::new(2.0 * s, s, s),
+        ];
+        build_from_faces(p, &[[0u32, 1, 4, 3], [1, 2, 5, 4], [5, 2, 6, 7]]).unwrap()
+    }
+
+    /// The faces of each island of `out`.
+    fn islands(out: &SchemeOutput) -> Vec<Vec<u32>> {
+        out.face_groups.iter().map(|g| g.faces.clone()).collect()
+    }
+
+    /// Every match label: (match number, panel index).
+    fn match_labels(out: &SchemeOutput) -> Vec<(u32, usize)> {
+        let mut found = Vec::new();
+        for (k, panel) in out.panels.iter().enumerate() {
+            for label in panel.labels {
+                if label.text.kind == &MATCH {
+                    found.push((label.text.number, k));
+                }
+            }
+        }
+        found.sort_unstable();
+        found
+    }
+
+    /// The interior edges whose faces lie in different islands of `out`.
+    fn edges_between_islands(mesh: &Mesh, out: &SchemeOutput) -> usize {
+        let mut island = vec![0usize; mesh.face_count()];
+        for (k, faces) in islands(out).iter().enumerate() {
+            for &f in faces {
+                island[f as usize] = k + 1;
+            }
+        }
+        mesh.edges()
+            .filter_map(|e| Some((mesh.face(e.half_edge())?, mesh.face(e.half_edge().twin())?)))
+            .filter(|(f, g)| island[f.index()] != island[g.index()])
+            .count()
+    }
+
+    #[test]
+    fn a_flat_grid_is_one_island_with_no_cut() {
+        let out = panels(&grid(3, 3), &options(None));
+        // Every edge is flat: all nine faces join, each interior edge a fold.
+        assert_eq!(islands(&out), vec![(0..9).collect::<Vec<u32>>()]);
+        assert_eq!((out.panels.len(), out.connections), (1, 0));
+        assert_eq!(out.panels.get(0).id().to_string(), "N1");
+        // 12 interior edges (2 rows of 3 plus 2 columns of 3), all folds; nothing to
+        // score.
+        assert_eq!(
+            out.report,
+            ["net: 1 islands (largest 9 faces, median 9); folds 0 mountain, 0 valley, 12 too flat to score, 480 mm in all; 0 cut edges, 0 mm in all, with 0 tabs"]
+        );
+    }
+
+    #[test]
+    fn the_flattest_edges_fold_first_and_the_sharp_one_is_cut() {
+        let mesh = step();
+        // With two faces an island, the flat edge 1 joins faces 0 and 1 before the
+        // 90° edge 5 is looked at; edge 5 is cut.
+        let out = panels(&mesh, &options(Some(2)));
+        assert_eq!(islands(&out), vec![vec![0, 1], vec![2]]);
+        assert_eq!(out.connections, 1);
+        // Both sides of the cut carry match number 1: N1 on face 1, N2 on its tab.
+        assert_eq!(match_labels(&out), [(1, 0), (1, 1)]);
+        assert_eq!(out.panels.get(1).facets.len(), 2, "face 2 and its tab");
+        // Without the cap the 90° edge folds too, as the join completes the part.
+        let out = panels(&mesh, &options(None));
+        assert_eq!(islands(&out), vec![vec![0, 1, 2]]);
+        assert_eq!(out.connections, 0);
+    }
+
+    #[test]
+    fn a_sprawling_join_waits_unless_it_completes_the_part() {
+        let mesh = ell();
+        // Edge ids follow the faces, so the row joins first, with face 7 (above face
+        // 0): hull (0,0), (7,0), (7,1), (1,2), (0,2) in sides, area 11 over 8 faces,
+        // 1.375 ≤ 1.5. Face 8 would make it (0,0), (7,0), (7,1), (1,3), (0,3), area 15
+        // over 9 faces, 1.67 > 1.5: faces 8 to 15 grow a second island, and 8 + 8
+        // faces pass the cap of 15.
+        let out = panels(&mesh, &options(Some(15)));
+        assert_eq!(
+            islands(&out),
+            vec![(0..8).collect::<Vec<u32>>(), (8..16).collect()]
+        );
+        assert_eq!(out.connections, 1);
+        // Uncapped, joining the two makes the whole part one island: made whatever its
+        // shape.
+        let out = panels(&mesh, &options(None));
+        assert_eq!(islands(&out), vec![(0..16).collect::<Vec<u32>>()]);
+        assert_eq!(out.connections, 0);
+    }
+
+    #[test]
+    fn the_island_cap_is_honoured_and_every_other_edge_is_cut() {
+        let mesh = grid(3, 3);
+        for cap in [1, 2, 3, 4] {
+            let out = panels(&mesh, &options(Some(cap)));
+            assert!(
+                islands(&out).iter().all(|f| f.len() <= cap),
+                "cap {cap}: {:?}",
+                islands(&out)
+            );
+            let mut all: Vec<u32> = islands(&out).concat();
+            all.sort_unstable();
+            assert_eq!(all, (0..9).collect::<Vec<u32>>(), "cap {cap}");
+            // At most `cap` faces each: at least ⌈9 / cap⌉ islands.
+            assert!(islands(&out).len() >= 9usize.div_ceil(cap), "cap {cap}");
+            assert_eq!(
+                out.connections,
+                edges_between_islands(&mesh, &out),
+                "cap {cap}"
+            );
+        }
+        // One face an island: every one of the 12 interior edges is a cut.
+        let out = panels(&mesh, &options(Some(1)));
+        assert_eq!((islands(&out).len(), out.connections), (9, 12));
+    }
+
+    #[test]
+    fn islands_are_numbered_from_1_in_the_order_of_their_lowest_face() {
+        let out = panels(&cube(), &options(Some(1)));
+        // One face an island: face k is island k + 1.
+        let expected: Vec<Vec<u32>> = (0..6).map(|f| vec![f]).collect();
+        assert_eq!(islands(&out), expected);
+        let ids: Vec<String> = out.panels.iter().map(|p| p.id().to_string()).collect();
+        assert_eq!(ids, ["N1", "N2", "N3", "N4", "N5", "N6"]);
+    }
+
+    #[test]
+    fn both_sides_of_every_cut_carry_its_match_number() {
+        let mesh = cube();
+        let out = panels(&mesh, &options(Some(1)));
+        // All 12 edges are cuts, numbered 1 to 12 in edge order.
+        assert_eq!(out.connections, 12);
+        let found = match_labels(&out);
+        assert_eq!(found.len(), 24);
+        for m in 1..=12u32 {
+            let e = EdgeId(m - 1);
+            let h = e.half_edge();
+            let sides = [mesh.face(h).unwrap().0, mesh.face(h.twin()).unwrap().0];
+            // Panel k is face k's island: the label is on the two faces of edge m − 1.
+            let mut on: Vec<u32> = found
+                .iter()
+                .filter(|(n, _)| *n == m)
+                .map(|&(_, k)| k as u32)
+                .collect();
+            on.sort_unstable();
+            let mut sides = sides.to_vec();
+            sides.sort_unstable();
+            assert_eq!(on, sides, "match {m}");
+        }
+        // The 12 tabs fit: a 40 mm face's centre is 20 mm from each edge.
+        assert!(out.notes.is_empty(), "{:?}", out.notes);
+    }
+
+    #[test]
+    fn a_closed_cube_unfolds_into_one_net_of_five_folds() {
+        let out = panels(&cube(), &options(None));
+        // A net of 6 faces is a tree: 5 of the 12 edges fold, 7 are cut.
+        assert_eq!(islands(&out), vec![(0..6).collect::<Vec<u32>>()]);
+        assert_eq!(out.connections, 7);
+    }
+
+    #[test]
+    fn the_options_refuse_an_empty_island_and_shrunk_faces() {
+        let panel = options(None).panel;
+        let mut values = OptionValues::default();
+        values.set("max-island-faces", "0");
+        let refused = Net.configure(&values, panel.clone()).unwrap_err();
+        assert_eq!(
+            refused,
+            "--max-island-faces: an island holds at least 1 face"
+        );
+        values.set("max-island-faces", "7");
+        let configured = Net.configure(&values, panel.clone()).unwrap();
+        let net = crate::scheme::AsAny::as_any(&*configured).downcast_ref::<NetOptions>();
+        assert_eq!(net.and_then(|n| n.max_island_faces), Some(7));
+        let shrunk = PanelOptions {
+            face_scale: 0.5,
+            ..panel
+        };
+        assert!(Net
+            .configure(&OptionValues::default(), shrunk)
+            .unwrap_err()
+            .starts_with("--face-scale: the net scheme keeps its faces whole"));
+    }
+}

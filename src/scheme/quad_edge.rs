@@ -349,3 +349,216 @@ impl<'a> FlatBand<'a> {
         corners
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::mesh::build::{tetrahedron, two_triangles};
+
+    /// Face 1 of [`two_triangles`] stood up at a right angle to face 0: (0,0,0),
+    /// (60,0,0), (30,0,30) in y = 0. Its band (face scale 0.5 about its centre
+    /// (30,0,10)) is (15,0,5), (45,0,5), (30,0,20): face 0's band (15,−5,0),
+    /// (30,−20,0), (45,−5,0) with y turned into −z.
+    const FOLDED: DVec3 = DVec3::new(30.0, 0.0, 30.0);
+
+    /// Edge options at face scale 0.5, bridge scale 0.5, 4 bend strips, flaps
+    /// `flap_scale` deep, and `holes` 1 mm holes per corner with `hole_margin` mm of
+    /// material round each.
+    fn options(holes: u32, hole_margin: f64, flap_scale: f64) -> EdgeOptions {
+        EdgeOptions {
+            panel: PanelOptions {
+                face_scale: 0.5,
+                holes,
+                hole_diameter: 1.0,
+                hole_margin,
+                label_height: 2.0,
+                panel_limit: None,
+            },
+            bridge_scale: 0.5,
+            flap_scale,
+            samples: 4,
+            deep_flaps: true,
+        }
+    }
+
+    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
+    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
+        assert_eq!(actual.len(), expected.len(), "{actual:?}");
+        for (p, q) in actual.iter().zip(expected) {
+            assert!(
+                p.distance(DVec3::from(*q)) < 1e-9,
+                "{actual:?} is not {expected:?}"
+            );
+        }
+    }
+
+    /// A panel's facets as index lists.
+    fn facets(panel: crate::panel::PanelRef<'_>) -> Vec<Vec<u32>> {
+        panel.facets.iter().map(<[u32]>::to_vec).collect()
+    }
+
+    #[test]
+    fn a_flap_runs_along_the_neighbouring_band_edges_to_its_inner_line() {
+        let flaps = flaps_in_band(&two_triangles(FOLDED), FaceId(0), &options(0, 0.5, 0.5));
+        // Face 0's centre is (30,−10,0); each corner moves halfway to it.
+        assert_points(
+            flaps.band(),
+            &[[15.0, -5.0, 0.0], [30.0, -20.0, 0.0], [45.0, -5.0, 0.0]],
+        );
+        // Band edge 2 (y = −5) is 5 mm from the centre: its inner line lies 0.5·5 mm in,
+        // at y = −7.5, where it meets the band edges x − y = 20 and x + y = 50.
+        assert_points(flaps.flap_rest(2), &[[17.5, -7.5, 0.0], [42.5, -7.5, 0.0]]);
+        // In a triangle the inner line at depth F is where the far corner's barycentric
+        // weight is F/3 = 1/6: (5/6)·B1 + (1/6)·B2 and (1/6)·B2 + (5/6)·B0 for edge 0.
+        assert_points(flaps.flap_rest(0), &[[32.5, -17.5, 0.0], [20.0, -5.0, 0.0]]);
+        assert_eq!((flaps.grown, flaps.reduced, flaps.bare.len()), (0, 0, 0));
+    }
+
+    #[test]
+    fn a_flap_of_scale_one_reaches_the_face_centre() {
+        let flaps = flaps_in_band(&two_triangles(FOLDED), FaceId(0), &options(0, 0.5, 1.0));
+        // The inner line of band edge 2 passes through the centre (30,−10,0): it meets
+        // the band edges at (2/3)·B0 + (1/3)·B1 and (1/3)·B1 + (2/3)·B2.
+        assert_points(
+            flaps.flap_rest(2),
+            &[[20.0, -10.0, 0.0], [40.0, -10.0, 0.0]],
+        );
+    }
+
+    #[test]
+    fn a_corner_pin_sits_at_the_middle_of_the_two_flaps_overlap() {
+        let flaps = flaps_in_band(&two_triangles(FOLDED), FaceId(0), &options(1, 0.5, 0.5));
+        // Corner 0's overlap is the parallelogram (15,−5), (20,−5), (22.5,−7.5),
+        // (17.5,−7.5), centred at (18.75,−6.25): 1.25 mm from y = −5 and y = −7.5, more
+        // than the 0.5 + 0.5 mm a hole needs. It goes through flaps 2 and 0 for
+        // connection 0 (the half-edge leaving the corner); corner 2's mirror image at
+        // x = 60 − 18.75 through flaps 1 and 2 for connection 4.
+        let holes = |k: usize| flaps.flap_holes(k).collect::<Vec<_>>();
+        let positions = |k: usize| holes(k).iter().map(|h| h.0).collect::<Vec<_>>();
+        let connections = |k: usize| holes(k).iter().map(|h| h.1).collect::<Vec<_>>();
+        assert_points(&positions(2), &[[18.75, -6.25, 0.0], [41.25, -6.25, 0.0]]);
+        assert_eq!(connections(2), [0, 4]);
+        assert_points(&positions(0)[..1], &[[18.75, -6.25, 0.0]]);
+        assert_eq!((flaps.grown, flaps.reduced, flaps.bare.len()), (0, 0, 0));
+    }
+
+    #[test]
+    fn a_corner_too_small_for_its_pin_grows_its_flaps_in_sixteenths() {
+        // A 1 mm hole with 1 mm of margin needs 1.5 mm all round; the 45° corners'
+        // overlaps at depth 0.5 are only 2.5 mm deep (1.25 mm from the middle).
+        let flaps = flaps_in_band(&two_triangles(FOLDED), FaceId(0), &options(1, 1.0, 0.5));
+        // Hugging corner 0 on its bisector (22.5° to y = −5), 1.5·1.0001 mm from both
+        // band edges, the pin needs a strip 3.0002 mm deep: depth 0.6 of the 5 mm, so
+        // 0.625, the first step of 1/16 past it. Both 45° corners grow; the right-angled
+        // one holds its pin at depth 0.5 (1.77 mm from every side).
+        assert_eq!((flaps.grown, flaps.reduced, flaps.bare.len()), (2, 0, 0));
+        // Flap 2 is 0.625·5 = 3.125 mm deep, its inner line meeting the band edges at
+        // (1 − 0.625/3)·B0 + (0.625/3)·B1 and the same from B2.
+        assert_points(
+            flaps.flap_rest(2),
+            &[[18.125, -8.125, 0.0], [41.875, -8.125, 0.0]],
+        );
+        let clear = 1.5 * 1.0001;
+        let reach = clear * (1.0 + 2f64.sqrt()); // clear / tan 22.5°
+        let pin = flaps.flap_holes(2).next().unwrap().0;
+        assert_points(&[pin], &[[15.0 + reach, -5.0 - clear, 0.0]]);
+    }
+
+    #[test]
+    fn an_interior_edge_panel_is_a_flap_a_developable_bend_and_a_flap() {
+        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        let panel = out.panels.get(2);
+        assert_eq!(panel.id().to_string(), "E2");
+        // Rails at v1 and v0 from face 0's band corner through b·v + (1 − b)·m
+        // (m = (30,0,0)) to face 1's: (x, −5(1 − t)², 5t²) for x = 45 and 15, at
+        // t = 0, 1/4, 1/2, 3/4, 1; so every ruling is 30 mm, half the edge. Then each
+        // flap's inner corners (face 1's: face 0's with y turned into −z).
+        let mut expected = Vec::new();
+        for i in 0..=4 {
+            let t = f64::from(i) / 4.0;
+            let (y, z) = (-5.0 * (1.0 - t) * (1.0 - t), 5.0 * t * t);
+            expected.push([45.0, y, z]);
+            expected.push([15.0, y, z]);
+        }
+        expected.extend([
+            [17.5, -7.5, 0.0],
+            [42.5, -7.5, 0.0],
+            [42.5, 0.0, 7.5],
+            [17.5, 0.0, 7.5],
+        ]);
+        assert_points(panel.vertices, &expected);
+        assert_eq!(
+            facets(panel),
+            vec![
+                vec![0, 1, 10, 11],
+                vec![1, 0, 2, 3],
+                vec![3, 2, 4, 5],
+                vec![5, 4, 6, 7],
+                vec![7, 6, 8, 9],
+                vec![9, 8, 12, 13],
+            ]
+        );
+        // Each flap carries the pins of both its corners: face 0's on facet 0 for
+        // connections 0 and 4, face 1's on facet 5 for connections 5 and 6 (the
+        // half-edges leaving (0,0,0) and (60,0,0) in face 1).
+        let holes: Vec<(u32, u32)> = panel
+            .holes
+            .iter()
+            .map(|h| (h.facet, h.connection))
+            .collect();
+        assert_eq!(holes, [(0, 0), (0, 4), (5, 5), (5, 6)]);
+        let positions: Vec<DVec3> = panel.holes.iter().map(|h| h.position).collect();
+        assert_points(
+            &positions,
+            &[
+                [18.75, -6.25, 0.0],
+                [41.25, -6.25, 0.0],
+                [18.75, 0.0, 6.25],
+                [41.25, 0.0, 6.25],
+            ],
+        );
+    }
+
+    #[test]
+    fn a_boundary_edge_panel_is_its_one_flap_sharing_the_corner_pin() {
+        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        let panel = out.panels.get(0);
+        assert_eq!(panel.id().to_string(), "E0");
+        // Band edge 0 of face 0 and its flap's inner corners.
+        assert_points(
+            panel.vertices,
+            &[
+                [15.0, -5.0, 0.0],
+                [30.0, -20.0, 0.0],
+                [32.5, -17.5, 0.0],
+                [20.0, -5.0, 0.0],
+            ],
+        );
+        assert_eq!(facets(panel), vec![vec![0, 1, 2, 3]]);
+        // Corner 0's pin, at the same point as on E2, for the same connection.
+        let pin = &panel.holes[0];
+        assert_points(&[pin.position], &[[18.75, -6.25, 0.0]]);
+        assert_eq!(pin.connection, 0);
+    }
+
+    #[test]
+    fn there_is_a_panel_per_edge_and_a_connection_per_face_corner() {
+        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        // 5 edges; 2 triangles have 6 corners.
+        assert_eq!((out.panels.len(), out.connections), (5, 6));
+        let ids: Vec<String> = out.panels.iter().map(|p| p.id().to_string()).collect();
+        assert_eq!(ids, ["E0", "E1", "E2", "E3", "E4"]);
+        assert_eq!(
+            out.notes,
+            ["4 boundary edges have a panel with a single flap and no bend"]
+        );
+        // The closed tetrahedron: 6 edges, 4 triangles of 3 corners, no note.
+        let mut mesh = tetrahedron();
+        mesh.scale(20.0);
+        let out = panels(&mesh, &options(0, 0.5, 0.5));
+        assert_eq!((out.panels.len(), out.connections), (6, 12));
+        assert!(out.notes.is_empty(), "{:?}", out.notes);
+    }
+}

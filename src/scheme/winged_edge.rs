@@ -241,3 +241,177 @@ fn face_flaps_at(
     parts.shrink_to_fit();
     parts
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec3;
+
+    use super::*;
+    use crate::mesh::build::two_triangles;
+
+    /// Face 1 of [`two_triangles`] stood up at a right angle to face 0, as in the
+    /// quad-edge tests: its band is face 0's (15,−5,0), (30,−20,0), (45,−5,0) about the
+    /// centre (30,−10,0), with y turned into −z.
+    const FOLDED: DVec3 = DVec3::new(30.0, 0.0, 30.0);
+
+    /// Winged-edge options at face scale 0.5, bridge scale 0.5, 4 bend strips, flaps
+    /// and wings 0.5 deep, `holes` 1 mm holes with 0.5 mm of margin per shared region.
+    fn options(holes: u32, shift: i32) -> WingedEdgeOptions {
+        WingedEdgeOptions {
+            edge: EdgeOptions {
+                panel: PanelOptions {
+                    face_scale: 0.5,
+                    holes,
+                    hole_diameter: 1.0,
+                    hole_margin: 0.5,
+                    label_height: 2.0,
+                    panel_limit: None,
+                },
+                bridge_scale: 0.5,
+                flap_scale: 0.5,
+                samples: 4,
+                deep_flaps: true,
+            },
+            shift,
+        }
+    }
+
+    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
+    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
+        assert_eq!(actual.len(), expected.len(), "{actual:?}");
+        for (p, q) in actual.iter().zip(expected) {
+            assert!(
+                p.distance(DVec3::from(*q)) < 1e-9,
+                "{actual:?} is not {expected:?}"
+            );
+        }
+    }
+
+    /// Face 0's flaps and wings at `--flap-scale` 0.5.
+    fn face_0(holes: u32, shift: i32) -> FaceFlaps {
+        let options = options(holes, shift);
+        face_flaps_at(&two_triangles(FOLDED), FaceId(0), &options.edge, shift, 0.5)
+    }
+
+    /// The centres and connections of the holes through flap `k`.
+    fn holes(flaps: &FaceFlaps, k: usize) -> (Vec<DVec3>, Vec<u32>) {
+        flaps.flap_holes(k).unzip()
+    }
+
+    #[test]
+    fn half_wings_reach_the_middle_of_both_neighbouring_edges() {
+        let flaps = face_0(0, 0);
+        // The inner polygon is the band halved about the centre: I0 = (22.5,−7.5),
+        // I1 = (30,−15), I2 = (37.5,−7.5). Edge 2's main flap B2, B0, I0, I2 has sides
+        // toward the centre (where quad-edge's run along the band edges to (17.5,−7.5)
+        // and (42.5,−7.5)); its wings cover half of each neighbouring sector, out to
+        // the band edges' middles (22.5,−12.5) and (37.5,−12.5).
+        assert_points(
+            flaps.flap_rest(2),
+            &[
+                [22.5, -12.5, 0.0],
+                [26.25, -11.25, 0.0],
+                [22.5, -7.5, 0.0],
+                [37.5, -7.5, 0.0],
+                [33.75, -11.25, 0.0],
+                [37.5, -12.5, 0.0],
+            ],
+        );
+        // Each corner's mark lies halfway between its band corner and inner corner.
+        assert_points(&[flaps.corner_label(0)], &[[18.75, -6.25, 0.0]]);
+    }
+
+    #[test]
+    fn a_full_wing_covers_the_next_or_the_previous_sector() {
+        // Shift 1: edge 2's wing covers all of sector 0 (B0, B1, I1, I0), out to B1.
+        assert_points(
+            face_0(0, 1).flap_rest(2),
+            &[
+                [30.0, -20.0, 0.0],
+                [30.0, -15.0, 0.0],
+                [22.5, -7.5, 0.0],
+                [37.5, -7.5, 0.0],
+            ],
+        );
+        // Shift −1: all of sector 1 (B1, B2, I2, I1), reached from the other side.
+        assert_points(
+            face_0(0, -1).flap_rest(2),
+            &[
+                [22.5, -7.5, 0.0],
+                [37.5, -7.5, 0.0],
+                [30.0, -15.0, 0.0],
+                [30.0, -20.0, 0.0],
+            ],
+        );
+    }
+
+    #[test]
+    fn half_wings_give_a_corner_two_shared_regions_and_twice_the_holes() {
+        let flaps = face_0(1, 0);
+        // Corner 0's regions: (30,−5), B0, I0, (30,−7.5) centred at (24.375,−6.25),
+        // 1.25 mm from y = −5 and y = −7.5; and B0, (22.5,−12.5), (26.25,−11.25), I0
+        // centred at (21.5625,−9.0625), 1.77 mm from x + y = 10 and x + y = 15. Corner 2's
+        // are their mirror images in x = 30. Flap 2 carries all four (connections 0
+        // and 4), where quad-edge's carries one per corner.
+        let (centres, connections) = holes(&flaps, 2);
+        assert_points(
+            &centres,
+            &[
+                [24.375, -6.25, 0.0],
+                [21.5625, -9.0625, 0.0],
+                [38.4375, -9.0625, 0.0],
+                [35.625, -6.25, 0.0],
+            ],
+        );
+        assert_eq!(connections, [0, 0, 4, 4]);
+        assert_eq!((flaps.reduced, flaps.bare.len()), (0, 0));
+    }
+
+    #[test]
+    fn a_full_wing_gives_a_corner_one_shared_region() {
+        let flaps = face_0(1, 1);
+        // Corner 0's region is sector 0, B0, B1, I1, I0, centred at (24.375,−11.875);
+        // corner 2's is sector 2, B2, B0, I0, I2, centred at (30,−6.25).
+        let (centres, connections) = holes(&flaps, 2);
+        assert_points(&centres, &[[24.375, -11.875, 0.0], [30.0, -6.25, 0.0]]);
+        assert_eq!(connections, [0, 4]);
+    }
+
+    #[test]
+    fn the_hinge_panel_has_the_quad_edge_bend_and_winged_flaps() {
+        let out = panels(&two_triangles(FOLDED), &options(1, 0));
+        // A panel per edge, a connection per face corner, as quad-edge.
+        assert_eq!((out.panels.len(), out.connections), (5, 6));
+        let panel = out.panels.get(2);
+        assert_eq!(panel.id().to_string(), "E2");
+        // 2·5 rail points, then 6 points for each flap; 1 + 4 + 1 facets.
+        assert_eq!((panel.vertices.len(), panel.facets.len()), (22, 6));
+        // The bend's middle ruling, as quad-edge's: (x, −5/4, 5/4) for x = 45, 15.
+        assert_points(
+            &panel.vertices[4..6],
+            &[[45.0, -1.25, 1.25], [15.0, -1.25, 1.25]],
+        );
+        // Four holes per flap (two regions at each of two corners), eight in all.
+        let per_facet: Vec<u32> = panel.holes.iter().map(|h| h.facet).collect();
+        assert_eq!(per_facet, [0, 0, 0, 0, 5, 5, 5, 5]);
+    }
+
+    #[test]
+    fn shift_is_one_of_minus_one_zero_and_one() {
+        let panel = options(2, 0).edge.panel;
+        let with_shift = |text: &str| {
+            let mut values = OptionValues::default();
+            values.set("shift", text);
+            WingedEdge.configure(&values, panel.clone())
+        };
+        assert_eq!(
+            with_shift("2").unwrap_err(),
+            "--shift: 2 must be -1, 0 or 1"
+        );
+        let configured = with_shift("-1").unwrap();
+        // Through the trait object: the `Box` itself is `Any` too.
+        let options =
+            crate::scheme::AsAny::as_any(&*configured).downcast_ref::<WingedEdgeOptions>();
+        assert_eq!(options.map(|o| o.shift), Some(-1));
+    }
+}
