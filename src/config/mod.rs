@@ -12,7 +12,7 @@ use serde::Deserialize;
 use crate::error::{Error, Result};
 use crate::export::laser::Speeds;
 use crate::export::{Format, Kind, Layers, SheetStyle};
-use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry};
+use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry, Scheme};
 
 pub mod defaults;
 mod file;
@@ -793,13 +793,67 @@ impl BuildOptions {
         self.resolve_with(model_path, &Registry::default())
     }
 
-    /// [`BuildOptions::resolve`] choosing the scheme from `registry`.
+    /// [`BuildOptions::resolve`] choosing the scheme from `registry`. Each part checks
+    /// its options in turn, so the first mistake reported is the first in this order.
     pub fn resolve_with(&self, model_path: &Path, registry: &Registry) -> Result<Job> {
-        let usage = |option: &str, e: String| Error::Usage(format!("--{option}: {e}"));
+        let sheet = self.sheet_settings()?;
+        let formats = Format::parse_list(self.format.as_deref().unwrap_or(defaults::FORMAT))
+            .map_err(|e| usage("format", e))?;
+        let scheme = self.chosen_scheme(registry)?;
+        let (face_scale, holes) = self.connections(scheme)?;
+        let nest = self.nest_settings()?;
+        let cuts = self.hole_and_kerf()?;
+        let panel = PanelOptions {
+            face_scale,
+            holes,
+            hole_diameter: cuts.hole_diameter,
+            hole_margin: cuts.hole_margin,
+            label_height: length_option(
+                "label-height",
+                &self.label_height,
+                defaults::LABEL_HEIGHT,
+            )?,
+            panel_limit: Some(sheet.panel_limit(nest.search.rotations)),
+        };
+        let options = scheme
+            .configure(&self.scheme_values, panel)
+            .map_err(Error::Usage)?;
+        Ok(Job {
+            nonplanar: self.nonplanar.unwrap_or(defaults::NONPLANAR),
+            nest,
+            style: self.sheet_style()?,
+            speeds: match &self.speeds {
+                Some(text) => Speeds::parse(text).map_err(Error::Usage)?,
+                None => Speeds::default(),
+            },
+            model_path: model_path.to_path_buf(),
+            model: self.model.resolve()?,
+            scheme: ConfiguredScheme {
+                scheme,
+                options: options.into(),
+            },
+            sheet: sheet.sheet,
+            margin: sheet.margin,
+            spacing: sheet.spacing,
+            kerf: cuts.kerf,
+            out: self.out_folder(model_path),
+            force: self.force,
+            map: !self.no_map,
+            strict: self.strict,
+            build_anyway: self.build_anyway,
+            json: self.json,
+            quiet: self.quiet,
+            formats,
+        })
+    }
+
+    /// The sheet, its margin and the spacing between parts, checked together (the
+    /// margins must leave room on the sheet).
+    fn sheet_settings(&self) -> Result<SheetSettings> {
+        let margin_text = self.margin.as_deref().unwrap_or(defaults::MARGIN);
         let sheet = parse_sheet(self.sheet.as_deref().unwrap_or(defaults::SHEET))
             .map_err(|e| usage("sheet", e))?;
-        let margin = parse_length(self.margin.as_deref().unwrap_or(defaults::MARGIN))
-            .map_err(|e| usage("margin", e))?;
+        let margin = parse_length(margin_text).map_err(|e| usage("margin", e))?;
         let spacing = parse_length(self.spacing.as_deref().unwrap_or(defaults::SPACING))
             .map_err(|e| usage("spacing", e))?;
         if margin < 0.0 || spacing < 0.0 {
@@ -810,15 +864,19 @@ impl BuildOptions {
         if 2.0 * margin >= sheet.width.min(sheet.height) {
             return Err(Error::Usage(format!(
                 "--margin {} leaves no room on a {} sheet ({:.1} x {:.1} mm)",
-                self.margin.as_deref().unwrap_or(defaults::MARGIN),
-                sheet.name,
-                sheet.width,
-                sheet.height
+                margin_text, sheet.name, sheet.width, sheet.height
             )));
         }
-        let formats = Format::parse_list(self.format.as_deref().unwrap_or(defaults::FORMAT))
-            .map_err(|e| usage("format", e))?;
-        let out = match &self.out {
+        Ok(SheetSettings {
+            sheet,
+            margin,
+            spacing,
+        })
+    }
+
+    /// `--out`, or a folder named after the model beside where the command runs.
+    fn out_folder(&self, model_path: &Path) -> PathBuf {
+        match &self.out {
             Some(dir) => dir.clone(),
             None => PathBuf::from(
                 model_path
@@ -826,10 +884,12 @@ impl BuildOptions {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_else(|| "unfold-out".to_string()),
             ),
-        };
-        let length = |option: &str, value: &Option<String>, default: &str| {
-            positive_length(option, value.as_deref(), default).map_err(Error::Usage)
-        };
+        }
+    }
+
+    /// The scheme `--scheme` names (or the registry's default), refusing an option of
+    /// another scheme given on the command line.
+    fn chosen_scheme(&self, registry: &Registry) -> Result<&'static dyn Scheme> {
         let scheme = match self.scheme.as_deref() {
             None => registry.default_scheme(),
             Some(name) => registry.get(name).ok_or_else(|| {
@@ -865,20 +925,31 @@ impl BuildOptions {
                 ),
             ));
         }
-        let defaults = scheme.defaults();
-        let face_scale =
-            fraction("face-scale", self.face_scale, defaults.face_scale).map_err(Error::Usage)?;
-        let holes = self.holes.unwrap_or(defaults.holes);
-        if !defaults.holes_allowed.contains(&holes) {
+        Ok(scheme)
+    }
+
+    /// `--face-scale` and `--holes`, whose defaults and allowed values are `scheme`'s.
+    fn connections(&self, scheme: &dyn Scheme) -> Result<(f64, u32)> {
+        let scheme_defaults = scheme.defaults();
+        let face_scale = fraction("face-scale", self.face_scale, scheme_defaults.face_scale)
+            .map_err(Error::Usage)?;
+        let holes = self.holes.unwrap_or(scheme_defaults.holes);
+        if !scheme_defaults.holes_allowed.contains(&holes) {
             return Err(usage(
                 "holes",
                 format!(
                     "{holes} holes per connection; the {} scheme takes {:?}",
                     scheme.name(),
-                    defaults.holes_allowed
+                    scheme_defaults.holes_allowed
                 ),
             ));
         }
+        Ok((face_scale, holes))
+    }
+
+    /// The nester and its search: `--nester`, `--rotations`, `--mirror`, `--effort`,
+    /// `--seed` and `--time-limit`.
+    fn nest_settings(&self) -> Result<NestSettings> {
         let rotations = self.rotations.unwrap_or(defaults::ROTATIONS);
         if !(1..=3600).contains(&rotations) {
             return Err(usage(
@@ -909,7 +980,7 @@ impl BuildOptions {
                     })
             })
             .transpose()?;
-        let nest = NestSettings {
+        Ok(NestSettings {
             nester: self.nester.unwrap_or(defaults::NESTER),
             search: NestOptions {
                 rotations,
@@ -918,20 +989,24 @@ impl BuildOptions {
                 seed: self.seed.unwrap_or(defaults::SEED),
                 time_limit,
             },
-        };
-        let hole_diameter = length(
+        })
+    }
+
+    /// `--hole-diameter`, `--kerf` (which must leave the holes open) and
+    /// `--hole-margin` (half the diameter unless given).
+    fn hole_and_kerf(&self) -> Result<HoleAndKerf> {
+        let hole_diameter = length_option(
             "hole-diameter",
             &self.hole_diameter,
             defaults::HOLE_DIAMETER,
         )?;
-        let kerf = parse_length(self.kerf.as_deref().unwrap_or(defaults::KERF))
-            .map_err(|e| usage("kerf", e))?;
+        let kerf_text = self.kerf.as_deref().unwrap_or(defaults::KERF);
+        let kerf = parse_length(kerf_text).map_err(|e| usage("kerf", e))?;
         if kerf < 0.0 || kerf >= hole_diameter {
             return Err(usage(
                 "kerf",
                 format!(
-                    "'{}' must be at least 0 and below the {hole_diameter:.3} mm --hole-diameter, which it shrinks by its width",
-                    self.kerf.as_deref().unwrap_or(defaults::KERF)
+                    "'{kerf_text}' must be at least 0 and below the {hole_diameter:.3} mm --hole-diameter, which it shrinks by its width"
                 ),
             ));
         }
@@ -945,57 +1020,64 @@ impl BuildOptions {
             }
             None => 0.5 * hole_diameter,
         };
-        let panel = PanelOptions {
-            face_scale,
-            holes,
+        Ok(HoleAndKerf {
             hole_diameter,
             hole_margin,
-            label_height: length("label-height", &self.label_height, defaults::LABEL_HEIGHT)?,
-            panel_limit: Some(PanelLimit {
-                width: sheet.width - 2.0 * margin,
-                height: sheet.height - 2.0 * margin,
-                rotations,
-            }),
-        };
-        let options = scheme
-            .configure(&self.scheme_values, panel)
-            .map_err(Error::Usage)?;
-        let scheme = ConfiguredScheme {
-            scheme,
-            options: options.into(),
-        };
-        Ok(Job {
-            nonplanar: self.nonplanar.unwrap_or(defaults::NONPLANAR),
-            nest,
-            style: SheetStyle {
-                layers: self.layers.resolve(length(
-                    "stroke-width",
-                    &self.stroke_width,
-                    defaults::STROKE_WIDTH,
-                )?)?,
-                labels_inside: self.labels.unwrap_or(defaults::LABELS) == LabelSide::Inside,
-            },
-            speeds: match &self.speeds {
-                Some(text) => Speeds::parse(text).map_err(Error::Usage)?,
-                None => Speeds::default(),
-            },
-            model_path: model_path.to_path_buf(),
-            model: self.model.resolve()?,
-            scheme,
-            sheet,
-            margin,
-            spacing,
             kerf,
-            out,
-            force: self.force,
-            map: !self.no_map,
-            strict: self.strict,
-            build_anyway: self.build_anyway,
-            json: self.json,
-            quiet: self.quiet,
-            formats,
         })
     }
+
+    /// How the sheets are drawn: `--stroke-width`, the config file's layers and
+    /// `--labels`.
+    fn sheet_style(&self) -> Result<SheetStyle> {
+        let stroke_width =
+            length_option("stroke-width", &self.stroke_width, defaults::STROKE_WIDTH)?;
+        Ok(SheetStyle {
+            layers: self.layers.resolve(stroke_width)?,
+            labels_inside: self.labels.unwrap_or(defaults::LABELS) == LabelSide::Inside,
+        })
+    }
+}
+
+/// A usage error of `--option`.
+fn usage(option: &str, why: String) -> Error {
+    Error::Usage(format!("--{option}: {why}"))
+}
+
+/// A positive length option: `value` or else `default`, in mm.
+fn length_option(option: &str, value: &Option<String>, default: &str) -> Result<f64> {
+    positive_length(option, value.as_deref(), default).map_err(Error::Usage)
+}
+
+/// The sheet and the room kept on it, resolved (mm).
+struct SheetSettings {
+    /// The sheet.
+    sheet: SheetSize,
+    /// Empty border on every sheet edge.
+    margin: f64,
+    /// Smallest gap between parts.
+    spacing: f64,
+}
+
+impl SheetSettings {
+    /// The largest panel the sheet takes inside its margins, in `rotations` steps.
+    fn panel_limit(&self, rotations: u32) -> PanelLimit {
+        PanelLimit {
+            width: self.sheet.width - 2.0 * self.margin,
+            height: self.sheet.height - 2.0 * self.margin,
+            rotations,
+        }
+    }
+}
+
+/// The fastener hole sizes and the kerf that shrinks them, resolved (mm).
+struct HoleAndKerf {
+    /// Hole diameter.
+    hole_diameter: f64,
+    /// Material between a hole's rim and any cut edge.
+    hole_margin: f64,
+    /// Laser kerf.
+    kerf: f64,
 }
 
 #[cfg(test)]
