@@ -874,7 +874,7 @@ impl BuildOptions {
         })
     }
 
-    /// `--out`, or a folder named after the model beside where the command runs.
+    /// `--out`, or a folder named after the model in the working folder.
     fn out_folder(&self, model_path: &Path) -> PathBuf {
         match &self.out {
             Some(dir) => dir.clone(),
