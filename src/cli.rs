@@ -67,7 +67,7 @@ enum Command {
 
         /// Preview this non-planar face policy: triangulate, planarize (runs the
         /// planarization and reports the errors before and after and the largest vertex
-        /// move) or error. [default: triangulate]
+        /// move) or error.
         #[arg(long, value_name = "POLICY")]
         nonplanar: Option<NonPlanar>,
 
@@ -180,7 +180,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<()> {
                     "--target-edges auto: the budget is found by a build (it depends on the scheme, the sheet and the size); give inspect a number of edges".to_string(),
                 ));
             }
-            let nonplanar = nonplanar.unwrap_or(NonPlanar::Triangulate);
+            let nonplanar = nonplanar.unwrap_or(crate::config::defaults::NONPLANAR);
             let report = crate::inspect(&model, &settings, nonplanar, registry)?;
             let text = if json {
                 serde_json::to_string_pretty(&report)

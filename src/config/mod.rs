@@ -12,8 +12,9 @@ use serde::Deserialize;
 use crate::error::{Error, Result};
 use crate::export::laser::Speeds;
 use crate::export::{Format, Kind, Layers, SheetStyle};
-use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry};
+use crate::scheme::{ConfiguredScheme, OptionValues, PanelLimit, PanelOptions, Registry, Scheme};
 
+pub mod defaults;
 mod file;
 pub use file::load_config;
 
@@ -130,50 +131,48 @@ fn nesters() -> impl clap::builder::TypedValueParser<Value = NesterName> {
 #[serde(rename_all = "kebab-case")]
 pub struct ModelOptions {
     /// Longest side of the model's bounding box when built, with a unit: 4ft, 1.2m,
-    /// 48in, 600mm. Overrides --units. [default: the model's own size in --units]
+    /// 48in, 600mm. Overrides --units.
     #[arg(long, value_name = "LENGTH")]
     pub size: Option<String>,
 
-    /// What one model unit is, when --size is not given. [default: mm]
+    /// What one model unit is, when --size is not given.
     #[arg(long, value_name = "UNIT")]
     pub units: Option<LengthUnit>,
 
-    /// Extra factor applied after --size or --units. [default: 1]
+    /// Extra factor applied after --size or --units.
     #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub scale: Option<f64>,
 
     /// Merge vertices that share a position where the mesh stays manifold (OBJ and OFF
-    /// keep them apart by default; STL is always welded). [default: off]
+    /// keep them apart by default; STL is always welded).
     #[arg(long)]
     #[serde(default)]
     pub weld: bool,
 
     /// Faces whose planarity error (largest corner distance from the best-fit plane,
-    /// divided by the face's diameter) exceeds this are non-planar. [default: 0.001]
+    /// divided by the face's diameter) exceeds this are non-planar.
     #[arg(long, value_name = "FRACTION")]
     pub planarity_tol: Option<f64>,
 
     /// Simplify a triangle mesh to about this many edges (within 2 %), keeping its
     /// holes and genus; `auto` simplifies only a model too detailed for its size, to
     /// the budget at which every panel holds its id and holes (tried, and named in the
-    /// report). [default: no simplification]
+    /// report).
     #[arg(long, value_name = "N|auto", conflicts_with = "target_faces")]
     pub target_edges: Option<TargetEdges>,
 
     /// Simplify a triangle mesh to about this many faces, keeping its holes and genus.
-    /// [default: no simplification]
     #[arg(long, value_name = "N")]
     pub target_faces: Option<usize>,
 
     /// What simplification favours: regular (even triangle sizes and shapes, so
     /// panels of one size) or accurate (the closest surface: few
     /// large triangles where the model is flat, many small ones where it curves).
-    /// [default: regular]
     #[arg(long, value_name = "MODE", value_parser = simplify_modes())]
     pub simplify_mode: Option<crate::mesh::simplify::SimplifyMode>,
 
     /// Remove connected components with fewer than N faces (stray fragments of a scan,
-    /// loose parts too small to build). [default: 0, keep every component]
+    /// loose parts too small to build).
     #[arg(long, value_name = "N")]
     pub min_component: Option<usize>,
 }
@@ -337,13 +336,13 @@ impl ModelOptions {
             }
             None => None,
         };
-        let scale = self.scale.unwrap_or(1.0);
+        let scale = self.scale.unwrap_or(defaults::SCALE);
         if !(scale.is_finite() && scale > 0.0) {
             return Err(Error::Usage(format!(
                 "--scale: {scale} must be a positive number"
             )));
         }
-        let planarity_tol = self.planarity_tol.unwrap_or(1e-3);
+        let planarity_tol = self.planarity_tol.unwrap_or(defaults::PLANARITY_TOL);
         if !(planarity_tol.is_finite() && planarity_tol > 0.0 && planarity_tol < 1.0) {
             return Err(Error::Usage(format!(
                 "--planarity-tol: {planarity_tol} must be between 0 and 1 (a fraction of the face size)"
@@ -369,10 +368,10 @@ impl ModelOptions {
             budget,
             auto_budget: self.target_edges == Some(TargetEdges::Auto),
             simplify_mode: self.simplify_mode.unwrap_or_default(),
-            min_component: self.min_component.unwrap_or(0),
+            min_component: self.min_component.unwrap_or(defaults::MIN_COMPONENT),
             scaling: Scaling {
                 size,
-                unit_mm: self.units.unwrap_or(LengthUnit::Mm).mm(),
+                unit_mm: self.units.unwrap_or(defaults::UNITS).mm(),
                 scale,
             },
             weld: self.weld,
@@ -391,136 +390,131 @@ pub struct BuildOptions {
     pub scheme: Option<String>,
 
     /// Sheet size: WxH with a unit (18x24in, 600x400mm) or a name (A0..A5, letter,
-    /// legal, tabloid). [default: 18x24in]
+    /// legal, tabloid).
     #[arg(long, value_name = "SIZE")]
     pub sheet: Option<String>,
 
-    /// Empty border kept on every sheet edge, with a unit. [default: 0.25in]
+    /// Empty border kept on every sheet edge, with a unit.
     #[arg(long, value_name = "LENGTH")]
     pub margin: Option<String>,
 
-    /// Smallest gap between two parts on a sheet, with a unit. [default: 0.125in]
+    /// Smallest gap between two parts on a sheet, with a unit.
     #[arg(long, value_name = "LENGTH")]
     pub spacing: Option<String>,
 
     /// Laser kerf, the width of material the beam burns away, with a unit: every closed
     /// cut loop moves half of it into the waste (outlines out, holes and inner cuts in)
     /// so parts come out at their nominal size; score and engrave lines stay. Below the
-    /// hole diameter. [default: 0mm, nominal geometry]
+    /// hole diameter.
     #[arg(long, value_name = "LENGTH")]
     pub kerf: Option<String>,
 
     /// Output folder, created if missing and replaced whole (never half-written). A
-    /// folder holding files unfold did not write is refused. [default: ./NAME, NAME
-    /// being the model's file name without extension]
+    /// folder holding files unfold did not write is refused.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
 
     /// Write into an --out folder that holds other files: replace only unfold's own
-    /// earlier output there and keep every other file. [default: off]
+    /// earlier output there and keep every other file.
     #[arg(long)]
     #[serde(default)]
     pub force: bool,
 
     /// Write no assembly map (NAME-map.svg: the model from six sides, each panel's id
-    /// where it sits, tinted by its sheet). [default: the map is written]
+    /// where it sits, tinted by its sheet).
     #[arg(long)]
     #[serde(default)]
     pub no_map: bool,
 
     /// The face the labels read on: outside, or inside (mirrored, for models assembled
-    /// inside out or cut face down). [default: outside]
+    /// inside out or cut face down).
     #[arg(long, value_name = "SIDE")]
     pub labels: Option<LabelSide>,
 
     /// Laser speeds in mm/s for the time estimate: any of cut, score, engrave and
-    /// travel (beam off). [default: cut=15,score=50,engrave=100,travel=300]
+    /// travel (beam off).
     #[arg(long, value_name = "LIST")]
     pub speeds: Option<String>,
 
-    /// Output formats, comma separated: svg, dxf. [default: svg]
+    /// Output formats, comma separated: svg, dxf.
     #[arg(long, value_name = "LIST")]
     pub format: Option<String>,
 
     /// Face band scale s: each panel corner moves toward the face centre,
-    /// s·v + (1−s)·c. [default: set by the scheme]
+    /// s·v + (1−s)·c.
     #[arg(long, value_name = "S")]
     pub face_scale: Option<f64>,
 
-    /// Fastener holes per connection. [default: set by the scheme]
+    /// Fastener holes per connection.
     #[arg(long, value_name = "N")]
     pub holes: Option<u32>,
 
-    /// Fastener hole diameter, with a unit. [default: 0.125in]
+    /// Fastener hole diameter, with a unit.
     #[arg(long, value_name = "LENGTH")]
     pub hole_diameter: Option<String>,
 
     /// Material kept between a fastener hole's rim and every cut edge of the panels it
     /// goes through, with a unit; half a hole diameter lets a fastener head of twice
     /// the hole's diameter bear on material all round.
-    /// [default: half the --hole-diameter]
     #[arg(long, value_name = "LENGTH")]
     pub hole_margin: Option<String>,
 
     /// Cap height of engraved labels, with a unit; shrunk to fit each panel, left out
-    /// below 1.5 mm. [default: 4mm]
+    /// below 1.5 mm.
     #[arg(long, value_name = "LENGTH")]
     pub label_height: Option<String>,
 
     /// What to do with faces that are not planar within --planarity-tol: triangulate
     /// (split along the diagonal that folds least), planarize (move vertices until every
     /// face is planar, staying close to the input; the report gives the largest move) or
-    /// error. [default: triangulate]
+    /// error.
     #[arg(long, value_name = "POLICY")]
     pub nonplanar: Option<NonPlanar>,
 
-    /// Rotation steps tried when laying panels on sheets (360°/N each). [default: 32]
+    /// Rotation steps tried when laying panels on sheets (360°/N each).
     #[arg(long, value_name = "N")]
     pub rotations: Option<u32>,
 
     /// Layout of panels on sheets: true-shape (outlines, tabs and flaps included;
     /// small parts fill the gaps of large ones) or shelf (bounding boxes in rows, the
-    /// baseline other unfolders use). [default: true-shape]
+    /// baseline other unfolders use).
     #[arg(long, value_name = "NESTER", value_parser = nesters())]
     pub nester: Option<NesterName>,
 
     /// Search effort of the true-shape nester, 1 to 100: samples per placement and
-    /// improvement rounds grow with it, and so does the time. [default: 5]
+    /// improvement rounds grow with it, and so does the time.
     #[arg(long, value_name = "N")]
     pub effort: Option<u32>,
 
     /// Seed of the true-shape search; the same seed and options give the same sheets.
-    /// [default: 0]
     #[arg(long, value_name = "N")]
     pub seed: Option<u64>,
 
     /// Also place panels mirrored (cut face down). Only for material without a
-    /// printed or finished side. [default: off]
+    /// printed or finished side.
     #[arg(long)]
     #[serde(default)]
     pub mirror: bool,
 
     /// Wall-clock cap on the nester's improvement and squeeze, in seconds. Off by
     /// default, since a time cap makes the result depend on the machine.
-    /// [default: none]
     #[arg(long, value_name = "SECONDS")]
     pub time_limit: Option<f64>,
 
     /// Stroke width in the SVG files, with a unit. Laser drivers treat only hairlines
-    /// as vector lines; a wider stroke is for previews. [default: 0.001in]
+    /// as vector lines; a wider stroke is for previews.
     #[arg(long, value_name = "LENGTH")]
     pub stroke_width: Option<String>,
 
     /// Refuse (exit 2) instead of warning when the model looks too small or too large
     /// for the sheet, or too detailed for its panels to carry labels and holes.
-    /// [default: off]
     #[arg(long)]
     #[serde(default)]
     pub strict: bool,
 
     /// Build a model too detailed for its size (most panels without room for their
     /// ids, or faces too small for any fastener hole) as it is, with a warning, instead
-    /// of stopping before the long stages with a budget that builds it. [default: off]
+    /// of stopping before the long stages with a budget that builds it.
     #[arg(long)]
     #[serde(default)]
     pub build_anyway: bool,
@@ -713,34 +707,20 @@ pub struct Job {
 
 impl BuildOptions {
     /// Completes a command holding these options with `registry`: the `--scheme`
-    /// values and default, the per-scheme defaults in `--help`, and every scheme's own
-    /// options.
+    /// values, every option's default at the end of its help (its subcommands' too),
+    /// and every scheme's own options.
     pub fn with_registry(command: clap::Command, registry: &Registry) -> clap::Command {
         let schemes: Vec<clap::builder::PossibleValue> = registry
             .schemes()
             .iter()
             .map(|s| clap::builder::PossibleValue::new(s.name()).help(s.about()))
             .collect();
-        let scheme_help = format!(
-            "Panel scheme: {}. [default: {}]",
-            registry.names().join(", "),
-            registry.default_scheme().name()
-        );
-        let face_scale_help = format!(
-            "Face band scale s: each panel corner moves toward the face centre, s·v + (1−s)·c. [default: {}]",
-            registry.describe_defaults(|d| d.face_scale)
-        );
-        let holes_help = format!(
-            "Fastener holes per connection. [default: {}]",
-            registry.describe_defaults(|d| d.holes)
-        );
-        command
-            .mut_arg("scheme", |a| {
-                a.value_parser(clap::builder::PossibleValuesParser::new(schemes))
-                    .help(scheme_help)
-            })
-            .mut_arg("face_scale", |a| a.help(face_scale_help))
-            .mut_arg("holes", |a| a.help(holes_help))
+        let scheme_help = format!("Panel scheme: {}", registry.names().join(", "));
+        let command = command.mut_arg("scheme", |a| {
+            a.value_parser(clap::builder::PossibleValuesParser::new(schemes))
+                .help(scheme_help)
+        });
+        defaults::state_defaults_in(command, &defaults::option_defaults(registry))
             .args(registry.options())
     }
 
@@ -813,14 +793,68 @@ impl BuildOptions {
         self.resolve_with(model_path, &Registry::default())
     }
 
-    /// [`BuildOptions::resolve`] choosing the scheme from `registry`.
+    /// [`BuildOptions::resolve`] choosing the scheme from `registry`. Each part checks
+    /// its options in turn, so the first mistake reported is the first in this order.
     pub fn resolve_with(&self, model_path: &Path, registry: &Registry) -> Result<Job> {
-        let usage = |option: &str, e: String| Error::Usage(format!("--{option}: {e}"));
-        let sheet = parse_sheet(self.sheet.as_deref().unwrap_or("18x24in"))
+        let sheet = self.sheet_settings()?;
+        let formats = Format::parse_list(self.format.as_deref().unwrap_or(defaults::FORMAT))
+            .map_err(|e| usage("format", e))?;
+        let scheme = self.chosen_scheme(registry)?;
+        let (face_scale, holes) = self.connections(scheme)?;
+        let nest = self.nest_settings()?;
+        let cuts = self.hole_and_kerf()?;
+        let panel = PanelOptions {
+            face_scale,
+            holes,
+            hole_diameter: cuts.hole_diameter,
+            hole_margin: cuts.hole_margin,
+            label_height: length_option(
+                "label-height",
+                &self.label_height,
+                defaults::LABEL_HEIGHT,
+            )?,
+            panel_limit: Some(sheet.panel_limit(nest.search.rotations)),
+        };
+        let options = scheme
+            .configure(&self.scheme_values, panel)
+            .map_err(Error::Usage)?;
+        Ok(Job {
+            nonplanar: self.nonplanar.unwrap_or(defaults::NONPLANAR),
+            nest,
+            style: self.sheet_style()?,
+            speeds: match &self.speeds {
+                Some(text) => Speeds::parse(text).map_err(Error::Usage)?,
+                None => Speeds::default(),
+            },
+            model_path: model_path.to_path_buf(),
+            model: self.model.resolve()?,
+            scheme: ConfiguredScheme {
+                scheme,
+                options: options.into(),
+            },
+            sheet: sheet.sheet,
+            margin: sheet.margin,
+            spacing: sheet.spacing,
+            kerf: cuts.kerf,
+            out: self.out_folder(model_path),
+            force: self.force,
+            map: !self.no_map,
+            strict: self.strict,
+            build_anyway: self.build_anyway,
+            json: self.json,
+            quiet: self.quiet,
+            formats,
+        })
+    }
+
+    /// The sheet, its margin and the spacing between parts, checked together (the
+    /// margins must leave room on the sheet).
+    fn sheet_settings(&self) -> Result<SheetSettings> {
+        let margin_text = self.margin.as_deref().unwrap_or(defaults::MARGIN);
+        let sheet = parse_sheet(self.sheet.as_deref().unwrap_or(defaults::SHEET))
             .map_err(|e| usage("sheet", e))?;
-        let margin = parse_length(self.margin.as_deref().unwrap_or("0.25in"))
-            .map_err(|e| usage("margin", e))?;
-        let spacing = parse_length(self.spacing.as_deref().unwrap_or("0.125in"))
+        let margin = parse_length(margin_text).map_err(|e| usage("margin", e))?;
+        let spacing = parse_length(self.spacing.as_deref().unwrap_or(defaults::SPACING))
             .map_err(|e| usage("spacing", e))?;
         if margin < 0.0 || spacing < 0.0 {
             return Err(Error::Usage(
@@ -830,15 +864,19 @@ impl BuildOptions {
         if 2.0 * margin >= sheet.width.min(sheet.height) {
             return Err(Error::Usage(format!(
                 "--margin {} leaves no room on a {} sheet ({:.1} x {:.1} mm)",
-                self.margin.as_deref().unwrap_or("0.25in"),
-                sheet.name,
-                sheet.width,
-                sheet.height
+                margin_text, sheet.name, sheet.width, sheet.height
             )));
         }
-        let formats = Format::parse_list(self.format.as_deref().unwrap_or("svg"))
-            .map_err(|e| usage("format", e))?;
-        let out = match &self.out {
+        Ok(SheetSettings {
+            sheet,
+            margin,
+            spacing,
+        })
+    }
+
+    /// `--out`, or a folder named after the model in the working folder.
+    fn out_folder(&self, model_path: &Path) -> PathBuf {
+        match &self.out {
             Some(dir) => dir.clone(),
             None => PathBuf::from(
                 model_path
@@ -846,10 +884,12 @@ impl BuildOptions {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_else(|| "unfold-out".to_string()),
             ),
-        };
-        let length = |option: &str, value: &Option<String>, default: &str| {
-            positive_length(option, value.as_deref(), default).map_err(Error::Usage)
-        };
+        }
+    }
+
+    /// The scheme `--scheme` names (or the registry's default), refusing an option of
+    /// another scheme given on the command line.
+    fn chosen_scheme(&self, registry: &Registry) -> Result<&'static dyn Scheme> {
         let scheme = match self.scheme.as_deref() {
             None => registry.default_scheme(),
             Some(name) => registry.get(name).ok_or_else(|| {
@@ -885,28 +925,39 @@ impl BuildOptions {
                 ),
             ));
         }
-        let defaults = scheme.defaults();
-        let face_scale =
-            fraction("face-scale", self.face_scale, defaults.face_scale).map_err(Error::Usage)?;
-        let holes = self.holes.unwrap_or(defaults.holes);
-        if !defaults.holes_allowed.contains(&holes) {
+        Ok(scheme)
+    }
+
+    /// `--face-scale` and `--holes`, whose defaults and allowed values are `scheme`'s.
+    fn connections(&self, scheme: &dyn Scheme) -> Result<(f64, u32)> {
+        let scheme_defaults = scheme.defaults();
+        let face_scale = fraction("face-scale", self.face_scale, scheme_defaults.face_scale)
+            .map_err(Error::Usage)?;
+        let holes = self.holes.unwrap_or(scheme_defaults.holes);
+        if !scheme_defaults.holes_allowed.contains(&holes) {
             return Err(usage(
                 "holes",
                 format!(
                     "{holes} holes per connection; the {} scheme takes {:?}",
                     scheme.name(),
-                    defaults.holes_allowed
+                    scheme_defaults.holes_allowed
                 ),
             ));
         }
-        let rotations = self.rotations.unwrap_or(32);
+        Ok((face_scale, holes))
+    }
+
+    /// The nester and its search: `--nester`, `--rotations`, `--mirror`, `--effort`,
+    /// `--seed` and `--time-limit`.
+    fn nest_settings(&self) -> Result<NestSettings> {
+        let rotations = self.rotations.unwrap_or(defaults::ROTATIONS);
         if !(1..=3600).contains(&rotations) {
             return Err(usage(
                 "rotations",
                 format!("{rotations} must be between 1 and 3600"),
             ));
         }
-        let effort = self.effort.unwrap_or(5);
+        let effort = self.effort.unwrap_or(defaults::EFFORT);
         if !(1..=100).contains(&effort) {
             return Err(usage(
                 "effort",
@@ -929,25 +980,33 @@ impl BuildOptions {
                     })
             })
             .transpose()?;
-        let nest = NestSettings {
-            nester: self.nester.unwrap_or(NesterName::TrueShape),
+        Ok(NestSettings {
+            nester: self.nester.unwrap_or(defaults::NESTER),
             search: NestOptions {
                 rotations,
                 mirror: self.mirror,
                 effort,
-                seed: self.seed.unwrap_or(0),
+                seed: self.seed.unwrap_or(defaults::SEED),
                 time_limit,
             },
-        };
-        let hole_diameter = length("hole-diameter", &self.hole_diameter, "0.125in")?;
-        let kerf =
-            parse_length(self.kerf.as_deref().unwrap_or("0mm")).map_err(|e| usage("kerf", e))?;
+        })
+    }
+
+    /// `--hole-diameter`, `--kerf` (which must leave the holes open) and
+    /// `--hole-margin` (half the diameter unless given).
+    fn hole_and_kerf(&self) -> Result<HoleAndKerf> {
+        let hole_diameter = length_option(
+            "hole-diameter",
+            &self.hole_diameter,
+            defaults::HOLE_DIAMETER,
+        )?;
+        let kerf_text = self.kerf.as_deref().unwrap_or(defaults::KERF);
+        let kerf = parse_length(kerf_text).map_err(|e| usage("kerf", e))?;
         if kerf < 0.0 || kerf >= hole_diameter {
             return Err(usage(
                 "kerf",
                 format!(
-                    "'{}' must be at least 0 and below the {hole_diameter:.3} mm --hole-diameter, which it shrinks by its width",
-                    self.kerf.as_deref().unwrap_or("0mm")
+                    "'{kerf_text}' must be at least 0 and below the {hole_diameter:.3} mm --hole-diameter, which it shrinks by its width"
                 ),
             ));
         }
@@ -961,57 +1020,64 @@ impl BuildOptions {
             }
             None => 0.5 * hole_diameter,
         };
-        let panel = PanelOptions {
-            face_scale,
-            holes,
+        Ok(HoleAndKerf {
             hole_diameter,
             hole_margin,
-            label_height: length("label-height", &self.label_height, "4mm")?,
-            panel_limit: Some(PanelLimit {
-                width: sheet.width - 2.0 * margin,
-                height: sheet.height - 2.0 * margin,
-                rotations,
-            }),
-        };
-        let options = scheme
-            .configure(&self.scheme_values, panel)
-            .map_err(Error::Usage)?;
-        let scheme = ConfiguredScheme {
-            scheme,
-            options: options.into(),
-        };
-        Ok(Job {
-            nonplanar: self.nonplanar.unwrap_or(NonPlanar::Triangulate),
-            nest,
-            style: SheetStyle {
-                layers: self.layers.resolve(length(
-                    "stroke-width",
-                    &self.stroke_width,
-                    "0.001in",
-                )?)?,
-                labels_inside: self.labels == Some(LabelSide::Inside),
-            },
-            speeds: match &self.speeds {
-                Some(text) => Speeds::parse(text).map_err(Error::Usage)?,
-                None => Speeds::default(),
-            },
-            model_path: model_path.to_path_buf(),
-            model: self.model.resolve()?,
-            scheme,
-            sheet,
-            margin,
-            spacing,
             kerf,
-            out,
-            force: self.force,
-            map: !self.no_map,
-            strict: self.strict,
-            build_anyway: self.build_anyway,
-            json: self.json,
-            quiet: self.quiet,
-            formats,
         })
     }
+
+    /// How the sheets are drawn: `--stroke-width`, the config file's layers and
+    /// `--labels`.
+    fn sheet_style(&self) -> Result<SheetStyle> {
+        let stroke_width =
+            length_option("stroke-width", &self.stroke_width, defaults::STROKE_WIDTH)?;
+        Ok(SheetStyle {
+            layers: self.layers.resolve(stroke_width)?,
+            labels_inside: self.labels.unwrap_or(defaults::LABELS) == LabelSide::Inside,
+        })
+    }
+}
+
+/// A usage error of `--option`.
+fn usage(option: &str, why: String) -> Error {
+    Error::Usage(format!("--{option}: {why}"))
+}
+
+/// A positive length option: `value` or else `default`, in mm.
+fn length_option(option: &str, value: &Option<String>, default: &str) -> Result<f64> {
+    positive_length(option, value.as_deref(), default).map_err(Error::Usage)
+}
+
+/// The sheet and the room kept on it, resolved (mm).
+struct SheetSettings {
+    /// The sheet.
+    sheet: SheetSize,
+    /// Empty border on every sheet edge.
+    margin: f64,
+    /// Smallest gap between parts.
+    spacing: f64,
+}
+
+impl SheetSettings {
+    /// The largest panel the sheet takes inside its margins, in `rotations` steps.
+    fn panel_limit(&self, rotations: u32) -> PanelLimit {
+        PanelLimit {
+            width: self.sheet.width - 2.0 * self.margin,
+            height: self.sheet.height - 2.0 * self.margin,
+            rotations,
+        }
+    }
+}
+
+/// The fastener hole sizes and the kerf that shrinks them, resolved (mm).
+struct HoleAndKerf {
+    /// Hole diameter.
+    hole_diameter: f64,
+    /// Material between a hole's rim and any cut edge.
+    hole_margin: f64,
+    /// Laser kerf.
+    kerf: f64,
 }
 
 #[cfg(test)]

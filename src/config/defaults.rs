@@ -1,0 +1,328 @@
+//! Every option's default, written once: the constants that resolution falls back on,
+//! and the table that ends each option's `--help` with `[default: …]` read from those
+//! same constants. README's option tables are checked against the table by
+//! `tests/options_table.rs`.
+//!
+//! A scheme can state its own options' defaults the same way: a constant per option
+//! that its `configure` falls back on, and [`OptionDefault::state_in`] applied to the
+//! arguments its `options()` returns.
+
+use std::fmt::Display;
+
+use crate::mesh::simplify::SimplifyMode;
+use crate::nest::NesterName;
+use crate::scheme::Registry;
+use crate::units::LengthUnit;
+
+use super::{LabelSide, NonPlanar};
+use crate::export::laser::Speeds;
+
+/// `--sheet`.
+pub const SHEET: &str = "18x24in";
+/// `--margin`.
+pub const MARGIN: &str = "0.25in";
+/// `--spacing`.
+pub const SPACING: &str = "0.125in";
+/// `--kerf`: none, so parts keep their nominal geometry.
+pub const KERF: &str = "0mm";
+/// `--format`.
+pub const FORMAT: &str = "svg";
+/// `--hole-diameter`.
+pub const HOLE_DIAMETER: &str = "0.125in";
+/// `--label-height`.
+pub const LABEL_HEIGHT: &str = "4mm";
+/// `--stroke-width`: a hairline, which laser drivers take as a vector line.
+pub const STROKE_WIDTH: &str = "0.001in";
+/// `--rotations`.
+pub const ROTATIONS: u32 = 32;
+/// `--effort`.
+pub const EFFORT: u32 = 5;
+/// `--seed`.
+pub const SEED: u64 = 0;
+/// `--nester`.
+pub const NESTER: NesterName = NesterName::TrueShape;
+/// `--nonplanar`, of the build and of `inspect`.
+pub const NONPLANAR: NonPlanar = NonPlanar::Triangulate;
+/// `--labels`.
+pub const LABELS: LabelSide = LabelSide::Outside;
+/// `--units`.
+pub const UNITS: LengthUnit = LengthUnit::Mm;
+/// `--scale`.
+pub const SCALE: f64 = 1.0;
+/// `--planarity-tol`.
+pub const PLANARITY_TOL: f64 = 1e-3;
+/// `--min-component`: 0 keeps every component.
+pub const MIN_COMPONENT: usize = 0;
+
+/// What an option's `[default: …]` states.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stated {
+    /// One value the option takes, written as on the command line (`0.25in`, `32`),
+    /// and words on what that value means, if any (`nominal geometry`).
+    Value {
+        /// The value.
+        text: String,
+        /// What the value means.
+        note: Option<&'static str>,
+    },
+    /// A value per scheme: `(scheme, value)` in the registry's order, and the
+    /// sentence `--help` shows for them.
+    PerScheme {
+        /// Each scheme's value.
+        values: Vec<(&'static str, String)>,
+        /// "1 for half-edge and net, 0.5 for …".
+        sentence: String,
+    },
+    /// Words for a default that is no single value (`off`, `none`, `the model's own
+    /// size in --units`).
+    Words(&'static str),
+}
+
+/// One option's default, by the option's long name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OptionDefault {
+    /// The long name, without dashes.
+    pub long: &'static str,
+    /// What its default is.
+    pub stated: Stated,
+}
+
+impl OptionDefault {
+    /// An option whose default is `value`.
+    pub fn value(long: &'static str, value: impl Display) -> OptionDefault {
+        OptionDefault {
+            long,
+            stated: Stated::Value {
+                text: value.to_string(),
+                note: None,
+            },
+        }
+    }
+
+    /// An option whose default is `value`, meaning `note`.
+    pub fn noted(long: &'static str, value: impl Display, note: &'static str) -> OptionDefault {
+        OptionDefault {
+            long,
+            stated: Stated::Value {
+                text: value.to_string(),
+                note: Some(note),
+            },
+        }
+    }
+
+    /// An option whose default is described by `words`.
+    pub fn words(long: &'static str, words: &'static str) -> OptionDefault {
+        OptionDefault {
+            long,
+            stated: Stated::Words(words),
+        }
+    }
+
+    /// The text between `[default: ` and `]`.
+    pub fn shown(&self) -> String {
+        match &self.stated {
+            Stated::Value { text, note: None } => text.clone(),
+            Stated::Value {
+                text,
+                note: Some(note),
+            } => format!("{text}, {note}"),
+            Stated::PerScheme { sentence, .. } => sentence.clone(),
+            Stated::Words(words) => words.to_string(),
+        }
+    }
+
+    /// `arg` with its help ending in this default (a sentence of its own).
+    pub fn state_in(&self, arg: clap::Arg) -> clap::Arg {
+        let suffix = format!("[default: {}]", self.shown());
+        let with_suffix = |text: String| {
+            // The derive drops a one-sentence doc comment's final period; the default
+            // follows as a sentence of its own.
+            if text.is_empty() || text.ends_with('.') {
+                format!("{text} {suffix}").trim_start().to_string()
+            } else {
+                format!("{text}. {suffix}")
+            }
+        };
+        let help = with_suffix(arg.get_help().map(|h| h.to_string()).unwrap_or_default());
+        let long_help = arg.get_long_help().map(|h| with_suffix(h.to_string()));
+        let arg = arg.help(help);
+        match long_help {
+            Some(text) => arg.long_help(text),
+            None => arg,
+        }
+    }
+}
+
+/// `args` with the help of each one `defaults` names ending in its default.
+pub fn state_defaults(args: Vec<clap::Arg>, defaults: &[OptionDefault]) -> Vec<clap::Arg> {
+    args.into_iter()
+        .map(|arg| match find(defaults, arg.get_long()) {
+            Some(default) => default.state_in(arg),
+            None => arg,
+        })
+        .collect()
+}
+
+/// `command` (and its subcommands) with the help of each option `defaults` names
+/// ending in its default.
+pub fn state_defaults_in(command: clap::Command, defaults: &[OptionDefault]) -> clap::Command {
+    command
+        .mut_args(|arg| match find(defaults, arg.get_long()) {
+            Some(default) => default.state_in(arg),
+            None => arg,
+        })
+        .mut_subcommands(|sub| state_defaults_in(sub, defaults))
+}
+
+/// The entry of `defaults` for the option called `long`.
+fn find<'a>(defaults: &'a [OptionDefault], long: Option<&str>) -> Option<&'a OptionDefault> {
+    let long = long?;
+    defaults.iter().find(|d| d.long == long)
+}
+
+/// The name an enum's value has on the command line.
+fn value_name(value: impl clap::ValueEnum) -> String {
+    value
+        .to_possible_value()
+        .map(|v| v.get_name().to_string())
+        .unwrap_or_default()
+}
+
+/// `--speeds`' default as the option writes it (`cut=15,score=50,…`).
+fn speeds_text(speeds: Speeds) -> String {
+    format!(
+        "cut={},score={},engrave={},travel={}",
+        speeds.cut, speeds.score, speeds.engrave, speeds.travel
+    )
+}
+
+/// A per-scheme default of the options every scheme takes.
+fn per_scheme<T: PartialEq + Display>(
+    long: &'static str,
+    registry: &Registry,
+    value: impl Fn(&crate::scheme::PanelDefaults) -> T,
+) -> OptionDefault {
+    OptionDefault {
+        long,
+        stated: Stated::PerScheme {
+            values: registry
+                .schemes()
+                .iter()
+                .map(|s| (s.name(), value(&s.defaults()).to_string()))
+                .collect(),
+            sentence: registry.describe_defaults(value),
+        },
+    }
+}
+
+/// The default of every option of the main command and of `inspect` but the schemes'
+/// own (an option both take has one default), in `--help` order.
+pub fn option_defaults(registry: &Registry) -> Vec<OptionDefault> {
+    type D = OptionDefault;
+    vec![
+        D::words("config", "none"),
+        D::value("scheme", registry.default_scheme().name()),
+        D::value("sheet", SHEET),
+        D::value("margin", MARGIN),
+        D::value("spacing", SPACING),
+        D::noted("kerf", KERF, "nominal geometry"),
+        D::words(
+            "out",
+            "./NAME, NAME being the model's file name without extension",
+        ),
+        D::words("force", "off"),
+        D::words("no-map", "the map is written"),
+        D::value("labels", value_name(LABELS)),
+        D::value("speeds", speeds_text(Speeds::default())),
+        D::value("format", FORMAT),
+        per_scheme("face-scale", registry, |d| d.face_scale),
+        per_scheme("holes", registry, |d| d.holes),
+        D::value("hole-diameter", HOLE_DIAMETER),
+        D::words("hole-margin", "half the --hole-diameter"),
+        D::value("label-height", LABEL_HEIGHT),
+        D::value("nonplanar", value_name(NONPLANAR)),
+        D::value("rotations", ROTATIONS),
+        D::value("nester", NESTER.as_str()),
+        D::value("effort", EFFORT),
+        D::value("seed", SEED),
+        D::words("mirror", "off"),
+        D::words("time-limit", "none"),
+        D::value("stroke-width", STROKE_WIDTH),
+        D::words("strict", "off"),
+        D::words("build-anyway", "off"),
+        D::words("json", "off"),
+        D::words("quiet", "off"),
+        D::words("size", "the model's own size in --units"),
+        D::value("units", value_name(UNITS)),
+        D::value("scale", SCALE),
+        D::words("weld", "off"),
+        D::value("planarity-tol", PLANARITY_TOL),
+        D::words("target-edges", "no simplification"),
+        D::words("target-faces", "no simplification"),
+        D::value("simplify-mode", SimplifyMode::default()),
+        D::noted("min-component", MIN_COMPONENT, "keep every component"),
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_read_as_the_command_line_writes_them() {
+        let defaults = option_defaults(&Registry::default());
+        let shown = |long: &str| find(&defaults, Some(long)).unwrap().shown();
+        assert_eq!(shown("margin"), "0.25in");
+        assert_eq!(shown("kerf"), "0mm, nominal geometry");
+        assert_eq!(shown("planarity-tol"), "0.001");
+        assert_eq!(shown("scale"), "1");
+        assert_eq!(shown("units"), "mm");
+        assert_eq!(shown("nester"), "true-shape");
+        assert_eq!(shown("simplify-mode"), "regular");
+        assert_eq!(shown("speeds"), "cut=15,score=50,engrave=100,travel=300");
+        assert_eq!(shown("scheme"), "half-edge");
+    }
+
+    #[test]
+    fn every_option_of_the_command_has_one_default() {
+        let registry = Registry::default();
+        let defaults = option_defaults(&registry);
+        let command = super::super::BuildOptions::command(&registry);
+        let scheme_own: Vec<String> = registry
+            .options()
+            .iter()
+            .filter_map(|a| a.get_long().map(str::to_string))
+            .collect();
+        for arg in command.get_arguments() {
+            let Some(long) = arg.get_long() else { continue };
+            if scheme_own.iter().any(|s| s == long) {
+                continue;
+            }
+            assert!(
+                find(&defaults, Some(long)).is_some(),
+                "--{long} has no default"
+            );
+            let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+            assert_eq!(help.matches("[default: ").count(), 1, "--{long}: {help}");
+        }
+        for (i, d) in defaults.iter().enumerate() {
+            assert!(
+                !defaults[..i].iter().any(|e| e.long == d.long),
+                "--{} twice",
+                d.long
+            );
+        }
+    }
+
+    #[test]
+    fn a_scheme_states_its_own_defaults_the_same_way() {
+        let arg = clap::Arg::new("tab_height")
+            .long("tab-height")
+            .help("Wanted overlap of a tab");
+        let stated = state_defaults(vec![arg], &[OptionDefault::value("tab-height", "8mm")]);
+        assert_eq!(
+            stated[0].get_help().unwrap().to_string(),
+            "Wanted overlap of a tab. [default: 8mm]"
+        );
+    }
+}
