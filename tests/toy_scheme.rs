@@ -42,12 +42,14 @@ use unfold::scheme::{
 
 struct Toy;
 
+/// `--toy-shrink`, written once: `configure` falls back on it and `--help` states it.
+const TOY_SHRINK: f64 = 0.9;
+
 static TOY: Toy = Toy;
 
 #[derive(clap::Args)]
 struct ToyArgs {
     /// How far each face shrinks toward its centre (toy): 1 keeps it whole.
-    /// [default: 0.9]
     #[arg(long, value_name = "S")]
     toy_shrink: Option<f64>,
 }
@@ -68,7 +70,13 @@ impl Scheme for Toy {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        unfold::scheme::args_of::<ToyArgs>()
+        unfold::config::defaults::state_defaults(
+            unfold::scheme::args_of::<ToyArgs>(),
+            &[unfold::config::defaults::OptionDefault::value(
+                "toy-shrink",
+                TOY_SHRINK,
+            )],
+        )
     }
 
     fn defaults(&self) -> PanelDefaults {
@@ -93,7 +101,7 @@ impl Scheme for Toy {
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
         let args: ToyArgs = values.parse()?;
-        let shrink = unfold::units::fraction("toy-shrink", args.toy_shrink, 0.9)?;
+        let shrink = unfold::units::fraction("toy-shrink", args.toy_shrink, TOY_SHRINK)?;
         Ok(Box::new(ToyOptions { panel, shrink }))
     }
 }
@@ -423,6 +431,8 @@ fn the_toy_option_is_a_config_key_and_is_checked() {
         Some("Options of toy"),
         "under its scheme's heading"
     );
+    let help = arg.get_help().unwrap().to_string();
+    assert!(help.ends_with("[default: 0.9]"), "{help}");
     let scheme = command
         .get_arguments()
         .find(|a| a.get_long() == Some("scheme"))

@@ -15,6 +15,7 @@ use i_overlay::mesh::float::style::OutlineStyle;
 use rayon::prelude::*;
 
 use super::{face_band, PanelDefaults, PanelOptions};
+use crate::config::defaults::OptionDefault;
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
@@ -30,21 +31,36 @@ pub const EDGE_DEFAULTS: PanelDefaults = PanelDefaults {
     holes_allowed: &[0, 1, 2, 4],
 };
 
+/// `--bridge-scale`.
+const BRIDGE_SCALE: f64 = 0.5;
+/// `--flap-scale`.
+const FLAP_SCALE: f64 = 0.5;
+/// `--samples`.
+const SAMPLES: u32 = 4;
+
+/// The defaults of the band options, for the edge schemes' `options()`.
+pub fn band_defaults() -> [OptionDefault; 3] {
+    [
+        OptionDefault::value("bridge-scale", BRIDGE_SCALE),
+        OptionDefault::value("flap-scale", FLAP_SCALE),
+        OptionDefault::value("samples", SAMPLES),
+    ]
+}
+
 /// The options of the edge band, shared by the edge schemes, as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 pub struct BandArgs {
     /// Edge band control points: b·v + (1−b)·m toward the edge midpoint m; smaller b
-    /// makes the bend rounder. [default: 0.5]
+    /// makes the bend rounder.
     #[arg(long, value_name = "B")]
     pub bridge_scale: Option<f64>,
 
     /// Flap depth: the flap's inner line joins the band corners moved this fraction
-    /// toward the face centre. [default: 0.5]
+    /// toward the face centre.
     #[arg(long, value_name = "F")]
     pub flap_scale: Option<f64>,
 
     /// Strips of the Bézier bend; every ruling between two strips is a score line.
-    /// [default: 4]
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
 }
@@ -52,14 +68,14 @@ pub struct BandArgs {
 impl BandArgs {
     /// Checks the values and fills in the defaults.
     pub fn resolve(&self, panel: PanelOptions) -> Result<EdgeOptions, String> {
-        let samples = self.samples.unwrap_or(4);
+        let samples = self.samples.unwrap_or(SAMPLES);
         if !(1..=64).contains(&samples) {
             return Err(format!("--samples: {samples} must be between 1 and 64"));
         }
         Ok(EdgeOptions {
             panel,
-            bridge_scale: fraction("bridge-scale", self.bridge_scale, 0.5)?,
-            flap_scale: fraction("flap-scale", self.flap_scale, 0.5)?,
+            bridge_scale: fraction("bridge-scale", self.bridge_scale, BRIDGE_SCALE)?,
+            flap_scale: fraction("flap-scale", self.flap_scale, FLAP_SCALE)?,
             samples,
             deep_flaps: true,
         })

@@ -14,6 +14,7 @@ use super::{
     args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
     SchemeOutput,
 };
+use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
@@ -98,10 +99,22 @@ pub enum Connectors {
     None,
 }
 
+/// `--connectors`.
+const CONNECTORS: Connectors = Connectors::Tab;
+/// `--connectors` as written.
+const CONNECTORS_TEXT: &str = "tab";
+/// `--tab-height`.
+const TAB_HEIGHT: &str = "8mm";
+
+/// The default of the tab option, for the `options()` of the schemes that glue tabs.
+pub(super) fn tab_defaults() -> OptionDefault {
+    OptionDefault::value("tab-height", TAB_HEIGHT)
+}
+
 /// The half-edge options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 struct HalfEdgeArgs {
-    /// Connectors on interior edges: tab or none. [default: tab]
+    /// Connectors on interior edges: tab or none.
     #[arg(long, value_name = "KIND")]
     connectors: Option<Connectors>,
 
@@ -113,7 +126,7 @@ struct HalfEdgeArgs {
 #[derive(Clone, Debug, Default, clap::Args)]
 pub(super) struct TabArgs {
     /// Wanted overlap of a tab on its neighbour panel, with a unit; tabs are shortened
-    /// where the neighbour is smaller. [default: 8mm]
+    /// where the neighbour is smaller.
     #[arg(long, value_name = "LENGTH")]
     tab_height: Option<String>,
 }
@@ -121,7 +134,7 @@ pub(super) struct TabArgs {
 impl TabArgs {
     /// The tab height (mm), checked, or its default.
     pub(super) fn height(&self) -> Result<f64, String> {
-        crate::units::positive_length("tab-height", self.tab_height.as_deref(), "8mm")
+        crate::units::positive_length("tab-height", self.tab_height.as_deref(), TAB_HEIGHT)
     }
 }
 
@@ -154,7 +167,13 @@ impl Scheme for HalfEdge {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        args_of::<HalfEdgeArgs>()
+        state_defaults(
+            args_of::<HalfEdgeArgs>(),
+            &[
+                OptionDefault::value("connectors", CONNECTORS_TEXT),
+                tab_defaults(),
+            ],
+        )
     }
 
     fn defaults(&self) -> PanelDefaults {
@@ -178,7 +197,7 @@ impl Scheme for HalfEdge {
         let args: HalfEdgeArgs = values.parse()?;
         Ok(Box::new(HalfEdgeOptions {
             panel,
-            tabs: args.connectors.unwrap_or(Connectors::Tab) == Connectors::Tab,
+            tabs: args.connectors.unwrap_or(CONNECTORS) == Connectors::Tab,
             tab_height: args.tab.height()?,
         }))
     }

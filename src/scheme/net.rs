@@ -25,9 +25,10 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3};
 
-use super::half_edge::{make_tab, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
+use super::half_edge::{make_tab, tab_defaults, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
+use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::surface::group_anchor;
 use crate::panel::{
@@ -77,6 +78,9 @@ pub static MATCH: IdKind = IdKind {
 /// The net scheme: islands of faces joined along folds, glue tabs on the cuts.
 pub struct Net;
 
+/// `--flat-fold` (degrees).
+const FLAT_FOLD_DEG: f64 = 1.0;
+
 /// The net scheme's options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 struct NetArgs {
@@ -84,18 +88,16 @@ struct NetArgs {
     tab: TabArgs,
 
     /// Most faces in one island (net scheme), for builders who want small pieces.
-    /// [default: no limit]
     #[arg(long, value_name = "N")]
     max_island_faces: Option<usize>,
 
     /// Folds flatter than this angle in degrees are not scored (net scheme).
-    /// [default: 1]
     #[arg(long, value_name = "DEGREES")]
     flat_fold: Option<f64>,
 
     /// Largest ratio of an island's convex hull to its area (net scheme, at least 1):
     /// smaller keeps islands compact so they pack on fewer sheets, larger makes fewer
-    /// islands. [default: 1.5]
+    /// islands.
     #[arg(long, value_name = "R")]
     island_spread: Option<f64>,
 }
@@ -125,7 +127,15 @@ impl Scheme for Net {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        args_of::<NetArgs>()
+        state_defaults(
+            args_of::<NetArgs>(),
+            &[
+                tab_defaults(),
+                OptionDefault::words("max-island-faces", "no limit"),
+                OptionDefault::value("flat-fold", FLAT_FOLD_DEG),
+                OptionDefault::value("island-spread", ISLAND_SPREAD),
+            ],
+        )
     }
 
     fn defaults(&self) -> PanelDefaults {
@@ -156,7 +166,7 @@ impl Scheme for Net {
         if args.max_island_faces == Some(0) {
             return Err("--max-island-faces: an island holds at least 1 face".into());
         }
-        let flat_fold = args.flat_fold.unwrap_or(1.0);
+        let flat_fold = args.flat_fold.unwrap_or(FLAT_FOLD_DEG);
         if !(0.0..90.0).contains(&flat_fold) {
             return Err(format!(
                 "--flat-fold: {flat_fold} must be an angle in degrees from 0 to below 90"

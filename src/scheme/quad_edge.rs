@@ -20,11 +20,12 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, notch_flap, place_pins, BandArgs, EdgeOptions, FaceFlaps,
-    WidenFor, EDGE_DEFAULTS,
+    band, band_defaults, corner_half_edges, edge_scheme, notch_flap, place_pins, BandArgs,
+    EdgeOptions, FaceFlaps, WidenFor, EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
+use crate::config::defaults::state_defaults;
 use crate::mesh::{FaceId, Mesh};
 use crate::plane::{clip_half_plane, contains, distance_to_border};
 use crate::record::Params;
@@ -44,7 +45,7 @@ impl Scheme for QuadEdge {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        args_of::<BandArgs>()
+        state_defaults(args_of::<BandArgs>(), &band_defaults())
     }
 
     fn defaults(&self) -> PanelDefaults {

@@ -16,16 +16,20 @@
 use glam::DVec2;
 
 use super::edge_panel::{
-    band, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions, FaceFlaps, WidenFor,
-    EDGE_DEFAULTS,
+    band, band_defaults, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions,
+    FaceFlaps, WidenFor, EDGE_DEFAULTS,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
+use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{FaceId, Mesh};
 use crate::record::Params;
 
 /// The winged-edge scheme: quad-edge panels with wings along the neighbouring edges.
 pub struct WingedEdge;
+
+/// `--shift`: a half-length wing on each side.
+const SHIFT: i32 = 0;
 
 /// The winged-edge options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
@@ -34,7 +38,7 @@ struct WingedEdgeArgs {
     band: BandArgs,
 
     /// Wings: 0 = a half-length wing on each side, 1 = one full-length wing over the
-    /// next edge's flap, -1 = over the previous edge's. [default: 0]
+    /// next edge's flap, -1 = over the previous edge's.
     #[arg(long, value_name = "S", allow_negative_numbers = true)]
     shift: Option<i32>,
 }
@@ -59,7 +63,9 @@ impl Scheme for WingedEdge {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        args_of::<WingedEdgeArgs>()
+        let mut defaults = band_defaults().to_vec();
+        defaults.push(OptionDefault::value("shift", SHIFT));
+        state_defaults(args_of::<WingedEdgeArgs>(), &defaults)
     }
 
     fn defaults(&self) -> PanelDefaults {
@@ -81,7 +87,7 @@ impl Scheme for WingedEdge {
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
         let args: WingedEdgeArgs = values.parse()?;
-        let shift = args.shift.unwrap_or(0);
+        let shift = args.shift.unwrap_or(SHIFT);
         if !(-1..=1).contains(&shift) {
             return Err(format!("--shift: {shift} must be -1, 0 or 1"));
         }

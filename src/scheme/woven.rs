@@ -28,6 +28,7 @@ use rayon::prelude::*;
 
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
+use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
@@ -44,23 +45,29 @@ use crate::units::fraction;
 /// The woven scheme: plain-weaving ribbons from the extended graph rotation system.
 pub struct Woven;
 
+/// `--band-scale`.
+const BAND_SCALE: f64 = 0.4;
+/// `--curl-limit`.
+const CURL_LIMIT: f64 = 3.0;
+/// `--thickness`.
+const THICKNESS: &str = "0.1in";
+
 /// The woven options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 struct WovenArgs {
     /// Strand width: a strand's end covers this fraction of the face band's side,
-    /// below 1. [default: 0.4]
+    /// below 1.
     #[arg(long, value_name = "T")]
     band_scale: Option<f64>,
 
     /// Curl limit: a ribbon segment's convex hull is at most this many times its area.
     /// Smaller cuts ribbons into more, straighter segments that nest on fewer sheets;
-    /// larger gives fewer joints. [default: 3]
+    /// larger gives fewer joints.
     #[arg(long, value_name = "R")]
     curl_limit: Option<f64>,
 
     /// Material thickness, with a unit: the two strands at a crossing are this far
     /// apart, one lifted and one lowered by half of it; 0 for flat ribbons.
-    /// [default: 0.1in]
     #[arg(long, value_name = "LENGTH")]
     thickness: Option<String>,
 }
@@ -89,7 +96,14 @@ impl Scheme for Woven {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        args_of::<WovenArgs>()
+        state_defaults(
+            args_of::<WovenArgs>(),
+            &[
+                OptionDefault::value("band-scale", BAND_SCALE),
+                OptionDefault::value("curl-limit", CURL_LIMIT),
+                OptionDefault::value("thickness", THICKNESS),
+            ],
+        )
     }
 
     fn defaults(&self) -> PanelDefaults {
@@ -119,17 +133,17 @@ impl Scheme for Woven {
         if panel.face_scale >= 1.0 {
             return Err("--face-scale: woven needs a face scale below 1: the strands cross in the gap between the face bands".to_string());
         }
-        let band_scale = fraction("band-scale", args.band_scale, 0.4)?;
+        let band_scale = fraction("band-scale", args.band_scale, BAND_SCALE)?;
         if band_scale >= 1.0 {
             return Err("--band-scale: woven needs a band scale below 1: a strand's end must stay clear of the band corner".to_string());
         }
-        let curl_limit = args.curl_limit.unwrap_or(3.0);
+        let curl_limit = args.curl_limit.unwrap_or(CURL_LIMIT);
         if !(curl_limit.is_finite() && curl_limit >= 1.5) {
             return Err(format!(
                 "--curl-limit: {curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"
             ));
         }
-        let text = args.thickness.as_deref().unwrap_or("0.1in");
+        let text = args.thickness.as_deref().unwrap_or(THICKNESS);
         let thickness =
             crate::units::parse_length(text).map_err(|e| format!("--thickness: {e}"))?;
         if !(thickness >= 0.0 && thickness.is_finite()) {
