@@ -23,6 +23,7 @@ pub mod load;
 pub mod memory;
 pub mod mesh;
 pub mod nest;
+pub mod option_default;
 pub mod panel;
 pub mod plane;
 pub mod record;

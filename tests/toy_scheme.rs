@@ -70,9 +70,9 @@ impl Scheme for Toy {
     }
 
     fn options(&self) -> Vec<clap::Arg> {
-        unfold::config::defaults::state_defaults(
+        unfold::option_default::state_defaults(
             unfold::scheme::args_of::<ToyArgs>(),
-            &[unfold::config::defaults::OptionDefault::value(
+            &[unfold::option_default::OptionDefault::value(
                 "toy-shrink",
                 TOY_SHRINK,
             )],

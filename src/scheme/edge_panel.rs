@@ -15,8 +15,8 @@ use i_overlay::mesh::float::style::OutlineStyle;
 use rayon::prelude::*;
 
 use super::{face_band, PanelDefaults, PanelOptions};
-use crate::config::defaults::OptionDefault;
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
+use crate::option_default::OptionDefault;
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, distance_to_border};
 use crate::record::Params;

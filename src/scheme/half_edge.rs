@@ -14,8 +14,8 @@ use super::{
     args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
     SchemeOutput,
 };
-use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
+use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 use crate::record::{round4, Params};
@@ -584,6 +584,7 @@ fn place_holes(
 mod tests {
     use super::*;
     use crate::mesh::build::{tetrahedron, two_triangles};
+    use crate::scheme::assert_points;
 
     /// Face 1 of [`two_triangles`] with its centre 40 mm from the hinge: high enough
     /// for a full tab of a few mm.
@@ -603,17 +604,6 @@ mod tests {
             },
             tabs: true,
             tab_height,
-        }
-    }
-
-    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
-    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
-        assert_eq!(actual.len(), expected.len(), "{actual:?}");
-        for (p, q) in actual.iter().zip(expected) {
-            assert!(
-                p.distance(DVec3::from(*q)) < 1e-9,
-                "{actual:?} is not {expected:?}"
-            );
         }
     }
 

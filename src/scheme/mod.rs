@@ -446,6 +446,19 @@ pub fn face_band(mesh: &Mesh, f: FaceId, s: f64) -> Vec<DVec3> {
         .collect()
 }
 
+/// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm: the
+/// schemes' unit tests compare their constructions with numbers worked out by hand.
+#[cfg(test)]
+pub(crate) fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
+    assert_eq!(actual.len(), expected.len(), "{actual:?}");
+    for (p, q) in actual.iter().zip(expected) {
+        assert!(
+            p.distance(DVec3::from(*q)) < 1e-9,
+            "{actual:?} is not {expected:?}"
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

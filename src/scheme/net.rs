@@ -28,8 +28,8 @@ use glam::{DVec2, DVec3};
 use super::half_edge::{make_tab, tab_defaults, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
-use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
+use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::surface::group_anchor;
 use crate::panel::{
     Covers, FaceGroup, FoldKind, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Source,

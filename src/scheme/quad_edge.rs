@@ -25,8 +25,8 @@ use super::edge_panel::{
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
-use crate::config::defaults::state_defaults;
 use crate::mesh::{FaceId, Mesh};
+use crate::option_default::state_defaults;
 use crate::plane::{clip_half_plane, contains, distance_to_border};
 use crate::record::Params;
 
@@ -357,6 +357,7 @@ mod tests {
 
     use super::*;
     use crate::mesh::build::{tetrahedron, two_triangles};
+    use crate::scheme::assert_points;
 
     /// Face 1 of [`two_triangles`] stood up at a right angle to face 0: (0,0,0),
     /// (60,0,0), (30,0,30) in y = 0. Its band (face scale 0.5 about its centre
@@ -381,17 +382,6 @@ mod tests {
             flap_scale,
             samples: 4,
             deep_flaps: true,
-        }
-    }
-
-    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
-    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
-        assert_eq!(actual.len(), expected.len(), "{actual:?}");
-        for (p, q) in actual.iter().zip(expected) {
-            assert!(
-                p.distance(DVec3::from(*q)) < 1e-9,
-                "{actual:?} is not {expected:?}"
-            );
         }
     }
 

@@ -21,8 +21,8 @@ use super::edge_panel::{
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
 use super::{SchemeError, SchemeOutput};
-use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::{FaceId, Mesh};
+use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::Params;
 
 /// The winged-edge scheme: quad-edge panels with wings along the neighbouring edges.
@@ -254,6 +254,7 @@ mod tests {
 
     use super::*;
     use crate::mesh::build::two_triangles;
+    use crate::scheme::assert_points;
 
     /// Face 1 of [`two_triangles`] stood up at a right angle to face 0, as in the
     /// quad-edge tests: its band is face 0's (15,−5,0), (30,−20,0), (45,−5,0) about the
@@ -279,17 +280,6 @@ mod tests {
                 deep_flaps: true,
             },
             shift,
-        }
-    }
-
-    /// Asserts that `actual` are the points `expected`, in order, within 1e-9 mm.
-    fn assert_points(actual: &[DVec3], expected: &[[f64; 3]]) {
-        assert_eq!(actual.len(), expected.len(), "{actual:?}");
-        for (p, q) in actual.iter().zip(expected) {
-            assert!(
-                p.distance(DVec3::from(*q)) < 1e-9,
-                "{actual:?} is not {expected:?}"
-            );
         }
     }
 

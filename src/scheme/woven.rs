@@ -28,10 +28,10 @@ use rayon::prelude::*;
 
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
-use crate::config::defaults::{state_defaults, OptionDefault};
 use crate::mesh::ergs::trace_cycles;
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
+use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::{
     Covers, FacetFrame, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source,
 };
