@@ -167,11 +167,6 @@ impl Source {
             covers: Covers::Edge(e),
         }
     }
-
-    /// The id printed for users (`F12`, `E123`, `C3.2`, `N4`).
-    pub fn name(self) -> Name {
-        self.id
-    }
 }
 
 /// A fastener hole: a circle at a 3D point on one facet, shared with the partner panel
@@ -467,7 +462,7 @@ impl Panel {
 
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
-        self.source.name()
+        self.source.id
     }
 
     /// The same panel, borrowed as the arena hands panels out.
@@ -510,7 +505,7 @@ impl<'a> From<&'a Panel> for PanelRef<'a> {
 impl PanelRef<'_> {
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
-        self.source.name()
+        self.source.id
     }
 
     /// An owned copy.
@@ -883,7 +878,7 @@ impl FlatPanel {
 
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
-        self.source.name()
+        self.source.id
     }
 
     /// The points of an outline loop.
@@ -923,7 +918,7 @@ pub struct FlatPanelRef<'a> {
 impl FlatPanelRef<'_> {
     /// The id printed for users (`F12`, `E123`, `C3.2`).
     pub fn id(&self) -> Name {
-        self.source.name()
+        self.source.id
     }
 
     /// The points of an outline loop.
@@ -1464,7 +1459,7 @@ mod tests {
             part_noun: "",
         };
         assert_eq!(Name::new(&BARE, 17).to_string(), "17");
-        assert_eq!(Source::edge(5).name().to_string(), "E5");
+        assert_eq!(Source::edge(5).id.to_string(), "E5");
         assert_eq!(Source::face(5).covers, Covers::Face(5));
     }
 }

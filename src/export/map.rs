@@ -375,7 +375,7 @@ fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mu
     candidates.sort_by(|&a, &b| (named[a], cells[b], a).cmp(&(named[b], cells[a], b)));
     let mut placed = Placed::new(text * 4.0);
     for p in candidates {
-        let id = panels.get(p).source.name().to_string();
+        let id = panels.get(p).id().to_string();
         let half = 0.5 * DVec2::new(CHAR_WIDTH * text * id.len() as f64, text);
         // The anchor, or where it is crowded, a point nearer the middle of one of
         // the panel's patches: always on the panel itself as seen.

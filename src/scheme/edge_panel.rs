@@ -682,7 +682,6 @@ fn edge_panel(
     let f = mesh.face(h).expect("an edge has a face on one side");
     let part = &faces[f.index()];
     let k = corner_of[h.index()] as usize;
-    let k1 = (k + 1) % part.corners();
     // The face across, its flaps and the corner the twin leaves from.
     let across = mesh
         .face(h.twin())
@@ -696,28 +695,17 @@ fn edge_panel(
     let rest_f = part.flap_rest(k);
     let rest_g = across.map_or(&[][..], |(_, other, k2)| other.flap_rest(k2));
 
-    // The rails at v and at v′ come first, in pairs sampled at the same t on both (so
-    // rulings stay parallel to the edge): rail point i is vertex 2i at v, 2i + 1 at v′.
     let mut vertices: Vec<DVec3> = Vec::with_capacity(2 * (n + 1) + rest_f.len() + rest_g.len());
+    push_rails(
+        mesh,
+        h,
+        (part, k),
+        across.map(|(_, o, k2)| (o, k2)),
+        n,
+        options,
+        &mut vertices,
+    );
     let (rail_v, rail_w) = (|i: usize| 2 * i as u32, |i: usize| 2 * i as u32 + 1);
-    match across {
-        Some((_, other, k2)) => {
-            let (v, w) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
-            let m = 0.5 * (v + w);
-            let b = options.bridge_scale;
-            let (cv, cw) = (b * v + (1.0 - b) * m, b * w + (1.0 - b) * m);
-            // In g the twin runs w → v: band corner k2 is at w, k2 + 1 at v.
-            let band_g = other.band();
-            let (gv, gw) = (band_g[(k2 + 1) % band_g.len()], band_g[k2]);
-            let band_f = part.band();
-            for i in 0..=n {
-                let t = i as f64 / n as f64;
-                vertices.push(bezier(band_f[k], cv, gv, t));
-                vertices.push(bezier(band_f[k1], cw, gw, t));
-            }
-        }
-        None => vertices.extend([part.band()[k], part.band()[k1]]),
-    }
 
     // One flap on a boundary edge, two otherwise; each flap is its two rail ends and
     // its rest, each bend strip a quad.
@@ -759,17 +747,64 @@ fn edge_panel(
         (g, other, k2, facet)
     });
 
-    // The panel id: on the middle strip of the bend, along the edge (on the flap for a
-    // boundary edge).
-    let (a, b) = (
-        vertices[rail_v(n / 2) as usize],
-        vertices[rail_w(n / 2) as usize],
-    );
+    let mut labels = Vec::with_capacity(1 + FLAP_LABELS * (1 + usize::from(n > 0)));
+    labels.push(id_label(e, &vertices, &facets, n, options));
+    flap_labels(mesh, part, f, h, k, 0, options, &mut labels);
+    if let Some((g, other, k2, facet)) = flap_g {
+        flap_labels(mesh, other, g, h.twin(), k2, facet, options, &mut labels);
+    }
+
+    Panel::new(Source::edge(e.0), vertices, facets, holes, labels)
+}
+
+/// The rails at v and at v′ of half-edge `h`'s panel, pushed onto `vertices` in pairs
+/// sampled at the same t on both (so rulings stay parallel to the edge): rail point i
+/// is vertex 2i at v, 2i + 1 at v′. The rails run in `n` strips from band corner k of
+/// its face (`own`) to the corners of the face across (`across`: its flaps and the
+/// corner the twin leaves from); on the boundary they are the band edge's two ends.
+fn push_rails(
+    mesh: &Mesh,
+    h: HalfedgeId,
+    (part, k): (&FaceFlaps, usize),
+    across: Option<(&FaceFlaps, usize)>,
+    n: usize,
+    options: &EdgeOptions,
+    vertices: &mut Vec<DVec3>,
+) {
+    let band_f = part.band();
+    let k1 = (k + 1) % part.corners();
+    let Some((other, k2)) = across else {
+        vertices.extend([band_f[k], band_f[k1]]);
+        return;
+    };
+    let (v, w) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
+    let m = 0.5 * (v + w);
+    let b = options.bridge_scale;
+    let (cv, cw) = (b * v + (1.0 - b) * m, b * w + (1.0 - b) * m);
+    // In g the twin runs w → v: band corner k2 is at w, k2 + 1 at v.
+    let band_g = other.band();
+    let (gv, gw) = (band_g[(k2 + 1) % band_g.len()], band_g[k2]);
+    for i in 0..=n {
+        let t = i as f64 / n as f64;
+        vertices.push(bezier(band_f[k], cv, gv, t));
+        vertices.push(bezier(band_f[k1], cw, gw, t));
+    }
+}
+
+/// Edge `e`'s panel id: on the middle strip of its `n`-strip bend, along the edge (on
+/// the flap for a boundary edge).
+fn id_label(
+    e: EdgeId,
+    vertices: &[DVec3],
+    facets: &Loops,
+    n: usize,
+    options: &EdgeOptions,
+) -> Label {
+    let (a, b) = (vertices[2 * (n / 2)], vertices[2 * (n / 2) + 1]);
     let id_facet = if n > 0 { 1 + n / 2 } else { 0 };
     let id_facet = id_facet.min(facets.len() - 1);
     let corners = &facets[id_facet];
-    let mut labels = Vec::with_capacity(1 + FLAP_LABELS * (1 + usize::from(n > 0)));
-    labels.push(Label {
+    Label {
         text: panel_id(e),
         anchor: corners.iter().map(|&i| vertices[i as usize]).sum::<DVec3>() / corners.len() as f64,
         direction: (b - a).normalize(),
@@ -778,13 +813,7 @@ fn edge_panel(
         kind: LabelKind::Panel,
         on_edge: false,
         slide: 0.3 * a.distance(b),
-    });
-    flap_labels(mesh, part, f, h, k, 0, options, &mut labels);
-    if let Some((g, other, k2, facet)) = flap_g {
-        flap_labels(mesh, other, g, h.twin(), k2, facet, options, &mut labels);
     }
-
-    Panel::new(Source::edge(e.0), vertices, facets, holes, labels)
 }
 
 /// Labels [`flap_labels`] puts on a flap.

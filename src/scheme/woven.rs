@@ -28,7 +28,7 @@ use rayon::prelude::*;
 
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
-use crate::mesh::ergs::trace_cycles;
+use crate::mesh::ergs::{trace_cycles, WeaveCycle};
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
 use crate::option_default::{state_defaults, OptionDefault};
@@ -523,81 +523,113 @@ pub fn ribbons(
     let normals: Vec<DVec3> = (0..mesh.edge_count() as u32)
         .map(|e| edge_piece_normal(mesh, EdgeId(e), &|f, v| strands.band(f, v)))
         .collect();
-    let half = 0.5 * options.thickness;
+    let weave = Weave {
+        mesh,
+        strands,
+        normals,
+        visits,
+        half: 0.5 * options.thickness,
+    };
     let mut notes = RibbonNotes::default();
+    let ribbons = cycles
+        .iter()
+        .enumerate()
+        .map(|(c, cycle)| cycle_ribbon(&weave, c as u32, cycle, &mut notes))
+        .collect();
+    Ok((ribbons, notes))
+}
 
-    let mut ribbons = Vec::with_capacity(cycles.len());
-    for (c, cycle) in cycles.iter().enumerate() {
-        let n = cycle.len();
-        let mut lines = Vec::with_capacity(4 * n);
-        let mut pieces = Vec::with_capacity(4 * n);
-        let mut refs = Vec::with_capacity(4 * n);
-        let mut corner_start = Vec::with_capacity(n);
-        for i in 0..n {
-            let (h, corner) = (cycle.darts[i], cycle.corners[i]);
-            let next = cycle.darts[(i + 1) % n];
-            let f = mesh
-                .face(corner)
-                .expect("traced corners are face half-edges");
-            let (u, w, q) = (mesh.origin(h), mesh.dest(h), mesh.dest(next));
-            // Entry: the side along h's edge, lifted or lowered as the strand crosses
-            // that edge; exit: the side along the next dart's edge.
-            // The line moves along the face normal, so the face pieces stay in
-            // planes parallel to the face, by as much as puts it half the thickness
-            // off the edge pieces' plane (both strands' edge pieces stay parallel,
-            // the thickness apart).
-            let face_normal = mesh.face_normal(f);
-            let lift = |dart: HalfedgeId, over: Option<bool>| {
-                let sign = if over.unwrap_or(true) { 1.0 } else { -1.0 };
-                let m = normals[dart.edge().index()];
-                sign * half / face_normal.dot(m).max(MIN_LIFT_COSINE) * face_normal
-            };
-            let (entry_lift, exit_lift) =
-                (lift(h, cycle.over[i]), lift(next, cycle.over[(i + 1) % n]));
-            let entry = strands.end(f, w, u);
-            let exit = strands.end(f, w, q);
-            let neighbours = [strands.corner_at(f, u), strands.corner_at(f, q)];
-            let (depth, tight) = landings(&strands, f, entry, exit, neighbours);
-            notes.tight_corners += usize::from(tight);
-            corner_start.push(pieces.len());
-            lines.push(entry.map(|p| p + entry_lift));
-            if depth[0] > 0.0 {
-                let line = [0, 1].map(|e| entry[e].lerp(exit[e], depth[0]) + entry_lift);
-                pieces.push(PieceKind::Face { corner });
-                refs.push(face_normal);
-                lines.push(line);
-            }
-            if depth[1] > 0.0 {
-                let line = [0, 1].map(|e| exit[e].lerp(entry[e], depth[1]) + exit_lift);
-                pieces.push(PieceKind::Face { corner });
-                refs.push(face_normal);
-                lines.push(line);
-            }
+/// What every cycle's ribbon is cut from.
+struct Weave<'a> {
+    mesh: &'a Mesh,
+    strands: Strands<'a>,
+    /// Each edge piece's plane normal.
+    normals: Vec<DVec3>,
+    /// The cycles crossing each edge (twice each).
+    visits: Vec<Vec<u32>>,
+    /// Half the material thickness (mm).
+    half: f64,
+}
+
+/// The ribbon of cycle `c`: at each of its face corners the entry and exit lines,
+/// lifted or lowered as the strand crosses, with the landings between; then the edge
+/// piece to the next corner. Corners too tight to turn are counted in `notes`.
+fn cycle_ribbon(weave: &Weave, c: u32, cycle: &WeaveCycle, notes: &mut RibbonNotes) -> Ribbon {
+    let Weave {
+        mesh,
+        strands,
+        normals,
+        visits,
+        half,
+    } = weave;
+    let (mesh, half) = (*mesh, *half);
+    let n = cycle.len();
+    let mut lines = Vec::with_capacity(4 * n);
+    let mut pieces = Vec::with_capacity(4 * n);
+    let mut refs = Vec::with_capacity(4 * n);
+    let mut corner_start = Vec::with_capacity(n);
+    for i in 0..n {
+        let (h, corner) = (cycle.darts[i], cycle.corners[i]);
+        let next = cycle.darts[(i + 1) % n];
+        let f = mesh
+            .face(corner)
+            .expect("traced corners are face half-edges");
+        let (u, w, q) = (mesh.origin(h), mesh.dest(h), mesh.dest(next));
+        // Entry: the side along h's edge, lifted or lowered as the strand crosses
+        // that edge; exit: the side along the next dart's edge.
+        // The line moves along the face normal, so the face pieces stay in
+        // planes parallel to the face, by as much as puts it half the thickness
+        // off the edge pieces' plane (both strands' edge pieces stay parallel,
+        // the thickness apart).
+        let face_normal = mesh.face_normal(f);
+        let lift = |dart: HalfedgeId, over: Option<bool>| {
+            let sign = if over.unwrap_or(true) { 1.0 } else { -1.0 };
+            let m = normals[dart.edge().index()];
+            sign * half / face_normal.dot(m).max(MIN_LIFT_COSINE) * face_normal
+        };
+        let (entry_lift, exit_lift) = (lift(h, cycle.over[i]), lift(next, cycle.over[(i + 1) % n]));
+        let entry = strands.end(f, w, u);
+        let exit = strands.end(f, w, q);
+        let neighbours = [strands.corner_at(f, u), strands.corner_at(f, q)];
+        let (depth, tight) = landings(strands, f, entry, exit, neighbours);
+        notes.tight_corners += usize::from(tight);
+        corner_start.push(pieces.len());
+        lines.push(entry.map(|p| p + entry_lift));
+        if depth[0] > 0.0 {
+            let line = [0, 1].map(|e| entry[e].lerp(exit[e], depth[0]) + entry_lift);
             pieces.push(PieceKind::Face { corner });
             refs.push(face_normal);
-            lines.push(exit.map(|p| p + exit_lift));
-            let e = next.edge();
-            pieces.push(PieceKind::Edge {
-                edge: e,
-                over: cycle.over[(i + 1) % n].unwrap_or(true),
-                crossing: other_visit(&visits[e.index()], c as u32),
-            });
-            refs.push(normals[e.index()]);
+            lines.push(line);
         }
-        let mut ribbon = Ribbon {
-            cycle: c as u32,
-            lines,
-            pieces,
-            facets: Vec::new(),
-            corner_start,
-        };
-        let flips = ring_flips(&ribbon, &refs);
-        ribbon.facets = (0..ribbon.pieces.len())
-            .map(|k| piece_facets(&ribbon, k, flips[k]))
-            .collect();
-        ribbons.push(ribbon);
+        if depth[1] > 0.0 {
+            let line = [0, 1].map(|e| exit[e].lerp(entry[e], depth[1]) + exit_lift);
+            pieces.push(PieceKind::Face { corner });
+            refs.push(face_normal);
+            lines.push(line);
+        }
+        pieces.push(PieceKind::Face { corner });
+        refs.push(face_normal);
+        lines.push(exit.map(|p| p + exit_lift));
+        let e = next.edge();
+        pieces.push(PieceKind::Edge {
+            edge: e,
+            over: cycle.over[(i + 1) % n].unwrap_or(true),
+            crossing: other_visit(&visits[e.index()], c),
+        });
+        refs.push(normals[e.index()]);
     }
-    Ok((ribbons, notes))
+    let mut ribbon = Ribbon {
+        cycle: c,
+        lines,
+        pieces,
+        facets: Vec::new(),
+        corner_start,
+    };
+    let flips = ring_flips(&ribbon, &refs);
+    ribbon.facets = (0..ribbon.pieces.len())
+        .map(|k| piece_facets(&ribbon, k, flips[k]))
+        .collect();
+    ribbon
 }
 
 /// The other cycle crossing an edge (the cycle itself when it crosses twice).
