@@ -15,7 +15,7 @@
 //! not a timing check. Each test runs all its cases, then fails naming every case that
 //! failed (each case's own message is printed above).
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::OsStr;

@@ -5,7 +5,7 @@
 //! a bad model, 2 for bad options), nothing on stdout and never a panic. Repairs must
 //! succeed (exit 0) and be listed under `notes:` in the report.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 

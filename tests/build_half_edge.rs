@@ -13,7 +13,7 @@
 //! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_half_edge golden` rewrites
 //! `tests/golden/tetrahedron-half-edge/`.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::ffi::OsStr;

@@ -4,7 +4,7 @@
 //! unroll exactly and that the independent sheet checker finds free of overlaps, the
 //! platonic solids as one island each, byte-identical output on 1 and 2 threads.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;

@@ -16,7 +16,7 @@
 //! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_quad_edge golden` rewrites
 //! `tests/golden/hexahedron-quad-edge/`.
 
-mod common;
+use crate::common;
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;

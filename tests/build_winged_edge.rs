@@ -7,7 +7,7 @@
 //! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_winged_edge golden` rewrites
 //! `tests/golden/hexahedron-winged-edge/`.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -8,7 +8,7 @@
 //! `UNFOLD_UPDATE_GOLDEN=1 cargo test --test build_woven golden` rewrites
 //! `tests/golden/tetrahedron-woven/`.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 

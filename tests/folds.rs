@@ -4,7 +4,7 @@
 //! planes) and the side of the fold's second facet from the first facet's plane, with
 //! each facet's outside read off the mesh face it lies on.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 

@@ -2,7 +2,7 @@
 //! independently computed ones (shared models, `../shared/models/README.md`) and the
 //! construction facts of the project's own generated models.
 
-mod common;
+use crate::common;
 
 use serde_json::Value;
 

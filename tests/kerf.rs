@@ -5,7 +5,7 @@
 //! nominal panels come from the library's own pipeline for the same job; the sheets are
 //! read with the tests' independent checker.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

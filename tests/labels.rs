@@ -4,7 +4,7 @@
 //! height on nearly every panel. The glyph boxes are measured from the strokes the
 //! exporters draw, not from the boxes label fitting used.
 
-mod common;
+use crate::common;
 
 use common::build::{inside, options, resolve, segment_distance, shared_models};
 use glam::DVec2;

@@ -4,7 +4,7 @@
 //! on the page, through the view's own projection written on the view's group — and
 //! `--no-map` turns it off.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 use std::path::Path;

@@ -3,7 +3,7 @@
 //! where true shapes can interlock, sheets ordered fullest first, mirrored placements,
 //! and byte-identical output for a seed whatever the thread count.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

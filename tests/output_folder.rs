@@ -4,7 +4,7 @@
 //! home folder (a temporary `HOME`) is never emptied; the model is never replaced; a
 //! file in the way of `--out` is named.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

@@ -2,7 +2,7 @@
 //! planar within the tolerance, reports the largest vertex move truthfully, leaves a
 //! planar mesh exactly as it was, and gives half-edge panels that unroll exactly.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
 //! Progress on stderr: shown under a terminal, never in a log. `script` (util-linux)
 //! gives the run a terminal; without it the terminal half is skipped with a message.
 
-mod common;
+use crate::common;
 
 use std::process::Command;
 

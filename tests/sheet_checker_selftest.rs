@@ -6,7 +6,7 @@
 //! when python3 has ezdxf (`pip install ezdxf`; required with `UNFOLD_REQUIRE_EZDXF=1`),
 //! with `tests/check_dxf.py` as well: every defect must be caught by each.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
 use std::time::Instant;

@@ -2,7 +2,7 @@
 //! from the config file (`[layers.cut]`) in both the SVG and the DXF, and labels that
 //! read on the inside face.
 
-mod common;
+use crate::common;
 
 use std::collections::BTreeSet;
 use std::process::Command;

@@ -2,7 +2,7 @@
 //! a valid manifold with the same genus and boundary loops, near the budget, the same
 //! every run; and the thesis' headline job runs end to end.
 
-mod common;
+use crate::common;
 
 use tempfile::TempDir;
 

@@ -4,7 +4,7 @@
 //! keep their genus, boundary loops and parts, reach the budget within 2 %, and pass
 //! the half-edge validator.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::TAU;
 use std::fmt::Write;

@@ -4,7 +4,7 @@
 //! model too detailed for its size warns with a `--target-edges` value that, run, gives
 //! panels that carry their ids.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

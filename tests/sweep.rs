@@ -3,7 +3,7 @@
 //! 101); and a panic, injected on purpose, is one line with exit code 1 and leaves the
 //! output folder as it was.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};

@@ -13,7 +13,7 @@
 //! (`"pair"` and the faces) and section (`pairs`), its own words in the map legend and
 //! its own anchor on the map (the middle of the fold), all from this file.
 
-mod common;
+use crate::common;
 
 use std::ffi::OsString;
 use std::path::Path;

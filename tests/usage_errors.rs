@@ -4,7 +4,7 @@
 //! or for the config file the line and column, the key, the nearest valid key and what
 //! the value should look like. Repeated options: the last one wins.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
