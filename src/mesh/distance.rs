@@ -47,9 +47,25 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
     a + ab * v + ac * w
 }
 
+/// The distance from `p` to the nearest point of the box `lo..hi`: no point of a
+/// triangle in the box lies nearer, so a search skips the triangle when this is
+/// beyond the nearest distance found.
+pub fn box_distance(p: DVec3, (lo, hi): (DVec3, DVec3)) -> f64 {
+    (lo - p).max(p - hi).max(DVec3::ZERO).length()
+}
+
+/// Whether a triangle whose box lies `bound` from a point can be as near as `best`:
+/// the bound is exact up to rounding, so `slack` (a hair of the model's size) keeps
+/// every triangle that could tie.
+pub fn may_reach(bound: f64, best: f64, slack: f64) -> bool {
+    bound <= best + slack
+}
+
 /// Triangles bucketed by a uniform grid, for nearest-distance queries.
 pub struct TriangleGrid<'a> {
     triangles: &'a [[DVec3; 3]],
+    /// Each triangle's bounding box.
+    boxes: Vec<(DVec3, DVec3)>,
     lo: DVec3,
     cell: f64,
     dims: [usize; 3],
@@ -82,8 +98,10 @@ impl<'a> TriangleGrid<'a> {
         let cells = dims[0] * dims[1] * dims[2];
         let mut counts = vec![0u32; cells + 1];
         let mut ranges = Vec::with_capacity(triangles.len());
+        let mut boxes = Vec::with_capacity(triangles.len());
         for t in triangles {
             let (tlo, thi) = super::geometry::bounding_box(t.iter().copied());
+            boxes.push((tlo, thi));
             let range = [0, 1, 2].map(|k| (index(tlo, k), index(thi, k)));
             for z in range[2].0..=range[2].1 {
                 for y in range[1].0..=range[1].1 {
@@ -112,6 +130,7 @@ impl<'a> TriangleGrid<'a> {
         }
         TriangleGrid {
             triangles,
+            boxes,
             lo,
             cell,
             dims,
@@ -146,7 +165,11 @@ impl<'a> TriangleGrid<'a> {
             {
                 break;
             }
+            let slack = 1e-9 * self.cell;
             self.visit_ring(home, ring, |t| {
+                if best.is_some_and(|b| !may_reach(box_distance(p, self.boxes[t]), b.2, slack)) {
+                    return;
+                }
                 let [a, b, c] = self.triangles[t];
                 let q = closest_point_on_triangle(p, a, b, c);
                 let d = q.distance(p);

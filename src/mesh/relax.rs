@@ -34,7 +34,8 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::distance::{closest_point_on_triangle, TriangleGrid};
+use super::distance::{box_distance, closest_point_on_triangle, may_reach, TriangleGrid};
+use super::geometry::bounding_box;
 
 /// Rounds over every vertex.
 const ROUNDS: usize = 20;
@@ -79,6 +80,11 @@ pub fn relax(positions: &mut [DVec3], triangles: &mut [[u32; 3]], surface: &Surf
     if triangles.is_empty() {
         return done;
     }
+    // A hair of the model's size: what a search's bounds allow for rounding.
+    let slack = {
+        let (lo, hi) = bounding_box(positions.iter().copied());
+        1e-9 * (hi - lo).length()
+    };
     // Every face's area vector before relaxing (or when it was made by a flip): a
     // face may never turn more than a quarter turn from it, nor shrink below a tenth
     // of it, however many moves it takes part in.
@@ -112,19 +118,17 @@ pub fn relax(positions: &mut [DVec3], triangles: &mut [[u32; 3]], surface: &Surf
             let around = rings.faces_around_faces(triangles);
             let fixed: &[DVec3] = positions;
             let shape: &[[u32; 3]] = triangles;
+            let boxes: Vec<(DVec3, DVec3)> = (0..shape.len())
+                .map(|g| bounding_box(corners_of(shape, g, fixed)))
+                .collect();
             nearest = surface
                 .samples
                 .par_iter()
                 .zip(&nearest)
                 .map(|(&p, &(f, _))| {
-                    around[f]
-                        .iter()
-                        .map(|&g| {
-                            let [a, b, c] = corners_of(shape, g, fixed);
-                            (g, closest_point_on_triangle(p, a, b, c).distance(p))
-                        })
-                        .min_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)))
-                        .expect("a face is around itself")
+                    nearest_around(p, f, &around[f], &boxes, slack, |g| {
+                        corners_of(shape, g, fixed)
+                    })
                 })
                 .collect();
         }
@@ -148,6 +152,34 @@ pub fn relax(positions: &mut [DVec3], triangles: &mut [[u32; 3]], surface: &Surf
         }
     }
     done
+}
+
+/// The nearest to `p` of the faces `around` (which hold `own`, the face measured
+/// first), with its distance; equally near ones go to the lowest index. A face whose
+/// box lies farther than the nearest found is not measured.
+fn nearest_around(
+    p: DVec3,
+    own: usize,
+    around: &[usize],
+    boxes: &[(DVec3, DVec3)],
+    slack: f64,
+    corners: impl Fn(usize) -> [DVec3; 3],
+) -> (usize, f64) {
+    let distance = |g: usize| {
+        let [a, b, c] = corners(g);
+        closest_point_on_triangle(p, a, b, c).distance(p)
+    };
+    let mut best = (own, distance(own));
+    for &g in around {
+        if g == own || !may_reach(box_distance(p, boxes[g]), best.1, slack) {
+            continue;
+        }
+        let d = distance(g);
+        if d.total_cmp(&best.1).then(g.cmp(&best.0)).is_lt() {
+            best = (g, d);
+        }
+    }
+    best
 }
 
 /// The area vector of a triangle.
