@@ -360,16 +360,23 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
 
 /// Stage 3, scheme: the job's scheme builds the 3D panels.
 pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
-    let output = job.scheme.build(&prepared.scheme_mesh.mesh).map_err(|e| {
-        let message = format!("{}: {e}", job.model_path.display());
-        if e.is_usage() {
-            Error::Usage(message)
-        } else {
-            Error::Build(message)
-        }
-    })?;
+    let output = job
+        .scheme
+        .build(&prepared.scheme_mesh.mesh)
+        .map_err(|e| scheme_error(job, e))?;
     crate::memory::release_freed();
     Ok(output)
+}
+
+/// A scheme's refusal of the job's model as the tool's error (a usage error when the
+/// options are at fault).
+fn scheme_error(job: &Job, e: crate::scheme::SchemeError) -> Error {
+    let message = format!("{}: {e}", job.model_path.display());
+    if e.is_usage() {
+        Error::Usage(message)
+    } else {
+        Error::Build(message)
+    }
 }
 
 /// Stage 4, flatten: unrolls every panel and fits its labels; a panel that overlaps
@@ -705,6 +712,10 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         warn(warning);
     }
     clock.lap("split");
+    // A mesh the scheme can never build is refused before any budget is tried for it.
+    job.scheme
+        .accepts(&prepared.scheme_mesh.mesh)
+        .map_err(|e| scheme_error(job, e))?;
     let budget = || prepared.clean_budget(job);
     crate::sanity::check_detail(job, &prepared.scheme_mesh.mesh, &budget)?;
     progress.stage("making the panels");

@@ -374,3 +374,52 @@ fn a_first_build_builds_clean_or_names_a_budget_that_does() {
         );
     }
 }
+
+/// An open dome of `n` × `n` quads (a height field over a square), as OBJ text.
+fn open_dome(n: usize) -> String {
+    let mut text = String::new();
+    for i in 0..=n {
+        for j in 0..=n {
+            let (x, y) = (i as f64 / n as f64 - 0.5, j as f64 / n as f64 - 0.5);
+            text += &format!("v {x} {y} {}\n", 0.5 - x * x - y * y);
+        }
+    }
+    let at = |i: usize, j: usize| i * (n + 1) + j + 1;
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            text += &format!("f {a} {b} {c} {d}\n");
+        }
+    }
+    text
+}
+
+#[test]
+fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
+    // Far too detailed for woven panels at 2 ft, and open: no budget could weave it,
+    // so the refusal names the holes, not a budget.
+    let tmp = TempDir::new().unwrap();
+    let dome = tmp.path().join("dome.obj");
+    std::fs::write(&dome, open_dome(120)).unwrap();
+    let out = tmp.path().join("out");
+    let run = build(&dome, &out, &["--scheme", "woven", "--size", "2ft"]);
+    assert_refused(
+        "open dome, woven",
+        &run,
+        &out,
+        &["weaving needs a closed mesh", "close the holes"],
+    );
+    assert!(
+        !run.stderr.contains("too detailed") && !run.stderr.contains("--target-edges"),
+        "{}",
+        run.stderr
+    );
+    // The same dome with the half-edge scheme is only too detailed: a budget is named.
+    let run = build(&dome, &out, &["--scheme", "half-edge", "--size", "2ft"]);
+    assert_refused(
+        "open dome, half-edge",
+        &run,
+        &out,
+        &["too detailed", "--target-edges "],
+    );
+}

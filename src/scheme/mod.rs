@@ -67,6 +67,12 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     fn panel(&self) -> &PanelOptions;
     /// Builds the panels of `mesh` (millimetres, faces as the scheme needs them).
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError>;
+    /// Refuses, before any size check or simplification trial, a mesh the scheme can
+    /// never build at any size or budget (its shape, not its detail), with the error
+    /// [`Configured::build`] would give. Accepts every mesh unless the scheme says.
+    fn accepts(&self, _mesh: &Mesh) -> Result<(), SchemeError> {
+        Ok(())
+    }
     /// Its own options as used, for the manifest's `scheme.params` (lengths in mm).
     fn params(&self) -> Params;
     /// The least fold (radians) scored on its panels: flatter hinges are left as they
@@ -337,6 +343,11 @@ impl ConfiguredScheme {
     pub fn options_as<T: 'static>(&self) -> Option<&T> {
         // Through the trait object: the `Arc` itself is `Any` too.
         AsAny::as_any(&*self.options).downcast_ref::<T>()
+    }
+
+    /// Refuses a mesh the scheme can never build ([`Configured::accepts`]).
+    pub fn accepts(&self, mesh: &Mesh) -> Result<(), SchemeError> {
+        self.options.accepts(mesh)
     }
 
     /// Builds the panels of `mesh`.

@@ -177,6 +177,10 @@ impl Configured for WovenOptions {
         panels(mesh, self)
     }
 
+    fn accepts(&self, mesh: &Mesh) -> Result<(), SchemeError> {
+        weave_cycles(mesh).map(|_| ())
+    }
+
     fn params(&self) -> Params {
         let mut params = Params::default();
         params.push("band_scale", self.band_scale);
@@ -494,17 +498,22 @@ pub struct RibbonNotes {
     pub tight_corners: usize,
 }
 
+/// The cycles of `mesh` with every edge twisted: an error naming the fix when the
+/// mesh is open (a walk reaches its boundary).
+fn weave_cycles(mesh: &Mesh) -> Result<Vec<WeaveCycle>, SchemeError> {
+    trace_cycles(mesh, &vec![true; mesh.edge_count()]).map_err(|e| {
+        SchemeError::Options(format!(
+            "the woven scheme cannot weave this mesh: {e}; close the holes of the mesh or use another --scheme"
+        ))
+    })
+}
+
 /// The ribbons of a closed mesh with every edge twisted, in cycle order.
 pub fn ribbons(
     mesh: &Mesh,
     options: &WovenOptions,
 ) -> Result<(Vec<Ribbon>, RibbonNotes), SchemeError> {
-    let cycles = trace_cycles(mesh, &vec![true; mesh.edge_count()])
-        .map_err(|e| {
-            SchemeError::Options(format!(
-                "the woven scheme cannot weave this mesh: {e}; close the holes of the mesh or use another --scheme"
-            ))
-        })?;
+    let cycles = weave_cycles(mesh)?;
     // The cycles crossing each edge (twice each).
     let mut visits: Vec<Vec<u32>> = vec![Vec::new(); mesh.edge_count()];
     for (c, cycle) in cycles.iter().enumerate() {
