@@ -1,5 +1,5 @@
 //! The first stage of every job and of `inspect`: read a model and prepare it
-//! (repairs, `--min-component`, simplification to a panel budget).
+//! (repairs, `--min-component`, `--fill-holes`, simplification to a panel budget).
 
 use std::path::Path;
 
@@ -34,6 +34,9 @@ pub fn load_model(
     )?;
     if settings.min_component > 1 {
         drop_small_components(path, settings.min_component, &mut prepared)?;
+    }
+    if settings.fill_holes {
+        fill_holes(&mut prepared)?;
     }
     if let Some(budget) = settings.budget {
         let (simplified, report) =
@@ -82,6 +85,24 @@ pub fn load_model(
 
 /// `--min-component`: removes the components of fewer than `min_faces` faces, with a
 /// note; refuses a model where nothing would be left.
+/// `--fill-holes`: every boundary loop closed by one face, with a note.
+fn fill_holes(prepared: &mut PreparedModel) -> Result<()> {
+    let filled = mesh::holes::fill_holes(&prepared.mesh)
+        .map_err(|e| error::Error::internal("closing the holes", e))?;
+    if let Some((closed, filled)) = filled {
+        prepared.notes.push(Note {
+            kind: "filled-holes",
+            message: format!(
+                "--fill-holes closed {} with one face each (the largest has {} edges)",
+                crate::units::count_of(filled.holes, "hole"),
+                filled.largest
+            ),
+        });
+        prepared.mesh = closed;
+    }
+    Ok(())
+}
+
 fn drop_small_components(
     path: &Path,
     min_faces: usize,

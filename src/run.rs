@@ -253,16 +253,20 @@ pub struct Prepared {
     pub notes: Vec<String>,
     /// Findings about the build's size, each naming its fix.
     pub warnings: Vec<String>,
+    /// Whether `--weld` would join vertices the model keeps apart.
+    can_weld: bool,
     /// The budget the warnings suggest, once one needed it.
-    clean_budget: std::cell::OnceCell<Option<usize>>,
+    clean_budget: std::cell::OnceCell<Option<crate::sanity::Suggestion>>,
 }
 
 impl Prepared {
     /// The budget at which the model, simplified, builds with nothing to warn of:
     /// found (by trial builds) the first time a warning asks.
-    pub fn clean_budget(&self, job: &Job) -> Option<usize> {
+    pub fn clean_budget(&self, job: &Job) -> Option<crate::sanity::Suggestion> {
         *self.clean_budget.get_or_init(|| {
-            crate::sanity::clean_budget(job, &self.scheme_mesh.mesh, &|n| model_at(job, n))
+            crate::sanity::clean_budget(job, &self.scheme_mesh.mesh, self.can_weld, &|n, r| {
+                model_at(job, n, r)
+            })
         })
     }
 }
@@ -291,12 +295,15 @@ pub struct Nested {
     pub notes: Vec<String>,
 }
 
-/// The job's model simplified to `edges` as `--target-edges` would do it, scaled and
-/// split for the scheme: what a warning's suggested budget is tried on.
-fn model_at(job: &Job, edges: usize) -> Option<crate::mesh::Mesh> {
+/// The job's model repaired as `repairs` say and simplified to `edges` as
+/// `--target-edges` would do it, scaled and split for the scheme: what a warning's
+/// suggested budget is tried on.
+fn model_at(job: &Job, edges: usize, repairs: crate::sanity::Repairs) -> Option<crate::mesh::Mesh> {
     let mut trial = job.clone();
     trial.model.budget = Some(crate::mesh::simplify::Budget::Edges(edges));
     trial.model.auto_budget = false;
+    trial.model.weld |= repairs.weld;
+    trial.model.fill_holes |= repairs.fill_holes;
     let loaded = load(&trial).ok()?;
     let mesh = scheme_mesh(&trial, &loaded.raw, loaded.prepared.mesh).ok()?;
     Some(mesh.mesh)
@@ -317,6 +324,11 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
         .iter()
         .map(|n| n.message.clone())
         .collect();
+    let can_weld = loaded
+        .prepared
+        .notes
+        .iter()
+        .any(|n| n.kind == "shared-positions");
     let scheme_mesh = scheme_mesh(job, &loaded.raw, loaded.prepared.mesh)?;
     let split = &scheme_mesh.split;
     if let Some(report) = scheme_mesh
@@ -354,6 +366,7 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
         topology,
         notes,
         warnings,
+        can_weld,
         clean_budget: std::cell::OnceCell::new(),
     })
 }
@@ -656,15 +669,16 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         return build(job, warn);
     }
     // `--target-edges auto`: a model too detailed for its size stops with the budget
-    // that was tried and builds clean; it is built again at that budget.
-    let mut said = Vec::new();
-    let mut warn_once = |w: &str| {
-        if !said.iter().any(|s| s == w) {
-            said.push(w.to_string());
-            warn(w);
+    // that was tried and builds clean; it is built again at that budget. The first
+    // attempt's warnings are held until it is known whether that build is the one
+    // kept: a rebuild at the budget makes them moot.
+    let mut held: Vec<String> = Vec::new();
+    let first = build(job, &mut |w: &str| {
+        if !held.iter().any(|s| s == w) {
+            held.push(w.to_string());
         }
-    };
-    match build(job, &mut warn_once) {
+    });
+    match first {
         Err(Error::TooDetailed {
             budget: Some(budget),
             ..
@@ -672,7 +686,7 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             let mut chosen = job.clone();
             chosen.model.auto_budget = false;
             chosen.model.budget = Some(crate::mesh::simplify::Budget::Edges(budget));
-            let mut outcome = build(&chosen, &mut warn_once)?;
+            let mut outcome = build(&chosen, warn)?;
             outcome.notes.insert(
                 0,
                 format!("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to {budget} edges, the budget at which every panel was tried and holds its id and fastener holes"),
@@ -680,13 +694,17 @@ pub fn run_observed(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
             Ok(outcome)
         }
         Ok(mut outcome) => {
+            held.iter().for_each(|w| warn(w));
             outcome.notes.insert(
                 0,
                 "--target-edges auto: the model builds as it is at this size, so it was not simplified".to_string(),
             );
             Ok(outcome)
         }
-        Err(e) => Err(e),
+        Err(e) => {
+            held.iter().for_each(|w| warn(w));
+            Err(e)
+        }
     }
 }
 

@@ -152,7 +152,7 @@ pub fn check_labels(
     mesh: &Mesh,
     panels: usize,
     left_out: &crate::labels::LeftOut,
-    budget: &dyn Fn() -> Option<usize>,
+    budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<Option<String>> {
     if panels == 0 || (left_out.panel as f64) <= IDS_LEFT_OUT * panels as f64 {
         return Ok(None);
@@ -171,7 +171,7 @@ pub fn check_labels(
 /// the smallest at which the scheme's panels hold their ids on an even mesh: most of
 /// them would have none, and the long stages would take minutes to make them
 /// ([`too_detailed`]). A build with `--build-anyway` goes on; the later checks warn.
-pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<usize>) -> Result<()> {
+pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggestion>) -> Result<()> {
     if job.build_anyway {
         return Ok(());
     }
@@ -202,36 +202,85 @@ fn too_detailed(
     mesh: &Mesh,
     what: &str,
     most: bool,
-    budget: &dyn Fn() -> Option<usize>,
+    budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<String> {
-    let budget = budget();
-    let fixes = detail_fixes(job, mesh, budget);
+    let suggestion = budget();
+    let fixes = detail_fixes(job, mesh, suggestion);
     if job.build_anyway || (job.model.budget.is_some() && !most) {
         let warning = format!("the model is too detailed for its size: {what}; {fixes}");
         strict(job, std::slice::from_ref(&warning))?;
         return Ok(warning);
     }
-    let auto = if budget.is_some() {
-        " (or --target-edges auto)"
-    } else {
-        ""
+    let auto = match suggestion {
+        Some(Suggestion { repairs, .. }) => format!(" (or {}--target-edges auto)", repairs.flags()),
+        None => String::new(),
     };
     Err(Error::TooDetailed {
         message: format!(
             "{} is too detailed for its size: {what}; stopped before laying out the sheets (nothing written): {fixes}{auto}; --build-anyway builds it as it is",
             job.model_path.display()
         ),
-        budget,
+        // `auto` takes only a budget that needs no other option.
+        budget: suggestion
+            .filter(|s| s.repairs == Repairs::default())
+            .map(|s| s.edges),
     })
+}
+
+/// A fix that was tried: the model, repaired as `repairs` say, simplified to `edges`
+/// builds clean.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Suggestion {
+    /// The `--target-edges` budget.
+    pub edges: usize,
+    /// The repairs it needs that the job did not ask for.
+    pub repairs: Repairs,
+}
+
+/// Repairs a suggested budget may need beyond the job's own options: the rims of a
+/// model's holes and its open seams keep edges too short at any budget.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Repairs {
+    /// `--weld`: join the parts that share vertex positions.
+    pub weld: bool,
+    /// `--fill-holes`: close every hole.
+    pub fill_holes: bool,
+}
+
+impl Repairs {
+    /// The options, each followed by a space (empty for none).
+    pub fn flags(&self) -> String {
+        let mut flags = String::new();
+        if self.weld {
+            flags += "--weld ";
+        }
+        if self.fill_holes {
+            flags += "--fill-holes ";
+        }
+        flags
+    }
+
+    /// Why a budget alone would not do.
+    fn reason(&self) -> &'static str {
+        match (self.weld, self.fill_holes) {
+            (true, _) => " (its open seams and holes keep edges too short at any budget)",
+            (false, true) => " (the rims of its holes keep edges too short at any budget)",
+            (false, false) => "",
+        }
+    }
 }
 
 /// The fixes of a model too detailed for its size: the `budget` that was tried and
 /// builds clean, and the size at which all but the shortest [`SHORT_TAIL`] of its
 /// edges reach the smallest edge at which the scheme's panels carry their labels.
-fn detail_fixes(job: &Job, mesh: &Mesh, budget: Option<usize>) -> String {
+fn detail_fixes(job: &Job, mesh: &Mesh, suggestion: Option<Suggestion>) -> String {
     let mut fixes = Vec::new();
-    if let Some(budget) = budget {
-        fixes.push(format!("--target-edges {budget}"));
+    if let Some(Suggestion { edges, repairs }) = suggestion {
+        fixes.push(format!(
+            "{}--target-edges {edges}{}",
+            repairs.flags(),
+            repairs.reason()
+        ));
     }
     let lengths = mesh.sorted_edge_lengths();
     if let (Some(buildable), false) = (smallest_buildable_edge(job, mesh), lengths.is_empty()) {
@@ -327,9 +376,10 @@ const PROBE_LARGEST: f64 = 2000.0;
 /// detail.
 const PROBE_SMALLEST: f64 = 0.5;
 
-/// The job's model simplified to a number of edges as `--target-edges` would, scaled
-/// and split as the scheme needs (`None` when that fails).
-pub type MeshAt<'a> = dyn Fn(usize) -> Option<Mesh> + 'a;
+/// The job's model repaired as the [`Repairs`] say (on top of its own options) and
+/// simplified to a number of edges as `--target-edges` would, scaled and split as the
+/// scheme needs (`None` when that fails).
+pub type MeshAt<'a> = dyn Fn(usize, Repairs) -> Option<Mesh> + 'a;
 
 /// Budgets a warning tries ([`checked_budget`]) before it gives up naming one.
 const BUDGET_TRIALS: usize = 10;
@@ -342,19 +392,67 @@ const BUDGET_STEP: f64 = 0.9;
 /// ([`trial`]). A budget makes even triangles, so the first tried is the number
 /// of edges whose triangles, [`SPREAD_MARGIN`] times the smallest that hold every
 /// panel's id (and every fastener hole), cover the model's area.
-pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
+///
+/// When no budget builds the model as it is, it is tried again repaired: its holes
+/// closed (`--fill-holes`), then, when it has parts that share vertex positions, its
+/// parts welded as well (`--weld`). A model with a hole whose rim is shorter than
+/// three edges that hold ids is tried with its holes closed straight away: no budget
+/// could build it open. `can_weld` says whether welding would join anything.
+pub fn clean_budget(
+    job: &Job,
+    mesh: &Mesh,
+    can_weld: bool,
+    mesh_at: &MeshAt,
+) -> Option<Suggestion> {
     let edges = mesh.edge_count();
     let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
     let covering = |edge: f64| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2));
-    let estimate = [
-        smallest_edge(job, 3, |output| ids_fit(job, output)),
-        smallest_fastened_edge(job),
-    ]
-    .into_iter()
-    .flatten()
-    .map(covering)
-    .fold(f64::INFINITY, f64::min);
-    checked_budget(job, round_down_2(estimate), edges, mesh_at)
+    let ids_edge = smallest_edge(job, 3, |output| ids_fit(job, output));
+    let estimate = [ids_edge, smallest_fastened_edge(job)]
+        .into_iter()
+        .flatten()
+        .map(covering)
+        .fold(f64::INFINITY, f64::min);
+    let estimate = round_down_2(estimate);
+    let rims = rim_lengths(mesh);
+    let can_fill = !job.model.fill_holes && !rims.is_empty();
+    let rim_too_short = ids_edge.is_some_and(|edge| rims.iter().any(|&rim| rim < RIM_EDGES * edge));
+    let can_weld = can_weld && !job.model.weld;
+    let mut tries = Vec::new();
+    if !(can_fill && rim_too_short) {
+        tries.push(Repairs::default());
+    }
+    if can_fill {
+        tries.push(Repairs {
+            weld: false,
+            fill_holes: true,
+        });
+    }
+    if can_weld {
+        tries.push(Repairs {
+            weld: true,
+            fill_holes: can_fill,
+        });
+    }
+    tries.into_iter().find_map(|repairs| {
+        checked_budget(job, estimate, edges, &|n| mesh_at(n, repairs))
+            .map(|edges| Suggestion { edges, repairs })
+    })
+}
+
+/// The fewest edges a hole's rim keeps at any budget: a triangle.
+const RIM_EDGES: f64 = 3.0;
+
+/// The length (mm) of the rim of each hole of `mesh`.
+fn rim_lengths(mesh: &Mesh) -> Vec<f64> {
+    mesh.boundary_loops()
+        .into_iter()
+        .map(|start| {
+            mesh.loop_from(start)
+                .map(|h| mesh.edge_length(h.edge()))
+                .sum()
+        })
+        .collect()
 }
 
 /// A budget a warning may suggest because it was tried: the first at which the model,
@@ -365,7 +463,12 @@ pub fn clean_budget(job: &Job, mesh: &Mesh, mesh_at: &MeshAt) -> Option<usize> {
 /// coarse (a panel larger than the sheet, or below the fewest edges the topology
 /// allows) by a larger one, and once both kinds were seen, by the budget halfway
 /// between them on a log scale. `None` when none of [`BUDGET_TRIALS`] builds clean.
-fn checked_budget(job: &Job, estimate: f64, edges: usize, mesh_at: &MeshAt) -> Option<usize> {
+fn checked_budget(
+    job: &Job,
+    estimate: f64,
+    edges: usize,
+    mesh_at: &dyn Fn(usize) -> Option<Mesh>,
+) -> Option<usize> {
     let mut budget = round_down_2(estimate.min(edges as f64 * BUDGET_STEP));
     // The largest budget found too coarse and the smallest found too detailed.
     let (mut coarse, mut detailed) = (None::<f64>, None::<f64>);
@@ -474,7 +577,7 @@ pub fn check_fasteners(
     job: &Job,
     mesh: &Mesh,
     output: &SchemeOutput,
-    budget: &dyn Fn() -> Option<usize>,
+    budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<Option<String>> {
     let bare = &output.unfastened;
     if bare.is_empty() {

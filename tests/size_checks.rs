@@ -407,7 +407,10 @@ fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
         "open dome, woven",
         &run,
         &out,
-        &["weaving needs a closed mesh", "close the holes"],
+        &[
+            "needs a closed mesh and this one has 1 hole",
+            "(--fill-holes)",
+        ],
     );
     assert!(
         !run.stderr.contains("too detailed") && !run.stderr.contains("--target-edges"),
@@ -421,5 +424,189 @@ fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
         &run,
         &out,
         &["too detailed", "--target-edges "],
+    );
+}
+
+/// A UV sphere of `rings` × `segments` whose northmost ring lies `hole` (radians) from
+/// the north pole, with no faces beyond it: a closed ball but for one small hole, as
+/// OBJ text.
+fn sphere_with_a_small_hole(rings: usize, segments: usize, hole: f64) -> String {
+    use std::f64::consts::PI;
+    let mut text = String::from("v 0 0 -1\n");
+    // Polar angles from the south pole: even steps, then the hole's rim.
+    let thetas: Vec<f64> = (1..rings)
+        .map(|k| k as f64 * PI / rings as f64)
+        .chain([PI - hole])
+        .collect();
+    for theta in &thetas {
+        for j in 0..segments {
+            let phi = j as f64 * 2.0 * PI / segments as f64;
+            let (x, y, z) = (
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                -theta.cos(),
+            );
+            text += &format!("v {x} {y} {z}\n");
+        }
+    }
+    let at = |k: usize, j: usize| 2 + k * segments + j % segments;
+    for j in 0..segments {
+        text += &format!("f 1 {} {}\n", at(0, j + 1), at(0, j));
+    }
+    for k in 0..thetas.len() - 1 {
+        for j in 0..segments {
+            let (a, b) = (at(k, j), at(k, j + 1));
+            let (c, d) = (at(k + 1, j + 1), at(k + 1, j));
+            text += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    text
+}
+
+#[test]
+fn a_hole_too_small_for_any_budget_gets_a_fix_that_closes_it() {
+    // At 2 ft the hole's rim is about 29 mm round: three quad-edge panels that hold
+    // their ids need more than that, so no budget builds the ball open.
+    let tmp = TempDir::new().unwrap();
+    let ball = tmp.path().join("ball.obj");
+    std::fs::write(&ball, sphere_with_a_small_hole(40, 40, 0.015)).unwrap();
+    let out = tmp.path().join("out");
+    let args = [
+        "--scheme",
+        "quad-edge",
+        "--size",
+        "2ft",
+        "--nester",
+        "shelf",
+    ];
+    let run = build(&ball, &out, &args);
+    assert_refused(
+        "ball",
+        &run,
+        &out,
+        &[
+            "too detailed for its size",
+            "try --fill-holes --target-edges ",
+            "the rims of its holes keep edges too short at any budget",
+            "(or --fill-holes --target-edges auto)",
+        ],
+    );
+    let budget = number_after(&run.stderr, "--fill-holes --target-edges ")
+        .unwrap()
+        .to_string();
+    // The fix named, run, builds with no warning; its note says what was closed.
+    let mut fixed = args.to_vec();
+    fixed.extend(["--fill-holes", "--target-edges", &budget]);
+    let run = build(&ball, &out, &fixed);
+    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    assert!(
+        run.stdout
+            .contains("--fill-holes closed 1 hole with one face each")
+            || run
+                .stderr
+                .contains("--fill-holes closed 1 hole with one face each"),
+        "{}{}",
+        run.stdout,
+        run.stderr
+    );
+    // `auto` alone cannot add the repair: it stops naming it; with it, it builds.
+    let run = build(
+        &ball,
+        &out,
+        &[&args[..], &["--target-edges", "auto", "--force"]].concat(),
+    );
+    assert_refusal("auto", &run, 2, &["--fill-holes --target-edges auto"]);
+    let run = build(
+        &ball,
+        &out,
+        &[
+            &args[..],
+            &["--fill-holes", "--target-edges", "auto", "--force"],
+        ]
+        .concat(),
+    );
+    assert_eq!(run.code, Some(0), "auto: {}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    // Closed, the ball has no boundary left.
+    let run = finish(
+        unfold_command()
+            .args(["inspect", "--fill-holes"])
+            .arg(&ball),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(run.stdout.contains("boundary loops 0"), "{}", run.stdout);
+}
+
+#[test]
+fn the_teapot_stops_naming_the_repairs_its_open_seams_need() {
+    let Some(shared) = shared_models("the_teapot_stops_naming_the_repairs_its_open_seams_need")
+    else {
+        return;
+    };
+    let teapot = shared.join("teapot.obj");
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let args = [
+        "--scheme",
+        "quad-edge",
+        "--size",
+        "2ft",
+        "--nester",
+        "shelf",
+    ];
+    let run = build(&teapot, &out, &args);
+    assert_refused(
+        "teapot",
+        &run,
+        &out,
+        &["try --weld --fill-holes --target-edges "],
+    );
+    let budget = number_after(&run.stderr, "--weld --fill-holes --target-edges ")
+        .unwrap()
+        .to_string();
+    let mut fixed = args.to_vec();
+    fixed.extend(["--weld", "--fill-holes", "--target-edges", &budget]);
+    let run = build(&teapot, &out, &fixed);
+    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+}
+
+#[test]
+fn auto_shows_only_the_warnings_of_the_build_it_keeps() {
+    let Some(shared) = shared_models("auto_shows_only_the_warnings_of_the_build_it_keeps") else {
+        return;
+    };
+    // As it is, suzanne at 4 ft warns of connections without holes before its label
+    // check stops it; simplified to the budget auto picks, it builds clean.
+    let suzanne = shared.join("suzanne.obj");
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let args = [
+        "--scheme",
+        "quad-edge",
+        "--size",
+        "4ft",
+        "--nester",
+        "shelf",
+    ];
+    let run = build(&suzanne, &out, &args);
+    assert!(
+        run.code == Some(2) && run.stderr.contains("warning: "),
+        "{}",
+        run.stderr
+    );
+    let run = build(
+        &suzanne,
+        &out,
+        &[&args[..], &["--target-edges", "auto"]].concat(),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    assert!(
+        run.stderr
+            .contains("--target-edges auto: the model is too detailed"),
+        "{}",
+        run.stderr
     );
 }

@@ -137,6 +137,7 @@ pub fn option_defaults(registry: &Registry) -> Vec<OptionDefault> {
         D::words("target-faces", "no simplification"),
         D::value("simplify-mode", SimplifyMode::default()),
         D::noted("min-component", MIN_COMPONENT, "keep every component"),
+        D::words("fill-holes", "off"),
     ]
 }
 

@@ -175,6 +175,13 @@ pub struct ModelOptions {
     /// loose parts too small to build).
     #[arg(long, value_name = "N")]
     pub min_component: Option<usize>,
+
+    /// Close every hole of the mesh with one face along its rim (a scan's open base, a
+    /// patch model's open rims): short rim edges no longer limit simplification, and
+    /// the woven scheme can weave the model.
+    #[arg(long)]
+    #[serde(default)]
+    pub fill_holes: bool,
 }
 
 /// A `--target-edges` value: a number of edges, or `auto`.
@@ -306,6 +313,8 @@ pub struct ModelSettings {
     pub simplify_mode: crate::mesh::simplify::SimplifyMode,
     /// Components with fewer faces than this are removed (0 keeps all).
     pub min_component: usize,
+    /// Close every boundary loop with one face.
+    pub fill_holes: bool,
 }
 
 impl ModelOptions {
@@ -321,6 +330,7 @@ impl ModelOptions {
             target_faces: self.target_faces.or(other.target_faces),
             simplify_mode: self.simplify_mode.or(other.simplify_mode),
             min_component: self.min_component.or(other.min_component),
+            fill_holes: self.fill_holes || other.fill_holes,
         }
     }
 
@@ -376,6 +386,7 @@ impl ModelOptions {
             },
             weld: self.weld,
             planarity_tol,
+            fill_holes: self.fill_holes,
         })
     }
 }

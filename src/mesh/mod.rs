@@ -11,6 +11,7 @@ pub mod distance;
 pub mod ergs;
 pub mod geometry;
 pub mod halfedge;
+pub mod holes;
 pub mod ids;
 pub mod planarize;
 pub mod polygons;

@@ -178,7 +178,14 @@ impl Configured for WovenOptions {
     }
 
     fn accepts(&self, mesh: &Mesh) -> Result<(), SchemeError> {
-        weave_cycles(mesh).map(|_| ())
+        // Every cycle walks across every edge twice: a hole's rim has one side only.
+        match mesh.boundary_loops().len() {
+            0 => Ok(()),
+            holes => Err(SchemeError::Options(format!(
+                "the woven scheme needs a closed mesh and this one has {}: close them (--fill-holes) or use another --scheme",
+                crate::units::count_of(holes, "hole")
+            ))),
+        }
     }
 
     fn params(&self) -> Params {
@@ -498,22 +505,16 @@ pub struct RibbonNotes {
     pub tight_corners: usize,
 }
 
-/// The cycles of `mesh` with every edge twisted: an error naming the fix when the
-/// mesh is open (a walk reaches its boundary).
-fn weave_cycles(mesh: &Mesh) -> Result<Vec<WeaveCycle>, SchemeError> {
-    trace_cycles(mesh, &vec![true; mesh.edge_count()]).map_err(|e| {
-        SchemeError::Options(format!(
-            "the woven scheme cannot weave this mesh: {e}; close the holes of the mesh or use another --scheme"
-        ))
-    })
-}
-
 /// The ribbons of a closed mesh with every edge twisted, in cycle order.
 pub fn ribbons(
     mesh: &Mesh,
     options: &WovenOptions,
 ) -> Result<(Vec<Ribbon>, RibbonNotes), SchemeError> {
-    let cycles = weave_cycles(mesh)?;
+    let cycles = trace_cycles(mesh, &vec![true; mesh.edge_count()]).map_err(|e| {
+        SchemeError::Options(format!(
+            "the woven scheme cannot weave this mesh: {e}; close its holes (--fill-holes) or use another --scheme"
+        ))
+    })?;
     // The cycles crossing each edge (twice each).
     let mut visits: Vec<Vec<u32>> = vec![Vec::new(); mesh.edge_count()];
     for (c, cycle) in cycles.iter().enumerate() {
