@@ -1,5 +1,6 @@
 //! The layering of the source tree, read from the files themselves: the schemes are
-//! named only inside `src/scheme/`, and each layer imports only what lies below it.
+//! named only inside `src/scheme/`, and each layer imports only what lies below it; and
+//! `cargo build` and `cargo test` build the dependencies with the same features.
 //!
 //! ```text
 //! error, units, record, rng, plane, font   (leaves)
@@ -205,4 +206,59 @@ fn the_import_reader_sees_grouped_and_inline_paths() {
     .unwrap();
     let found: Vec<String> = crate_modules(&file).into_iter().map(|(_, m)| m).collect();
     assert_eq!(found, ["mesh", "nest", "plane", "units", "scheme"]);
+}
+
+/// `cargo tree` of this package with the given edge kinds: each package and version
+/// with its enabled features, once.
+fn features_by_package(edges: &str) -> std::collections::BTreeMap<String, String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_string());
+    let out = std::process::Command::new(cargo)
+        .args(["tree", "--offline", "--prefix", "none", "-e", edges])
+        .args(["-f", "{p}|{f}"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo tree: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.split_once('|'))
+        .map(|(package, features)| {
+            let package = package
+                .trim_end_matches(" (*)")
+                .trim_end_matches(" (proc-macro)");
+            (
+                package.to_string(),
+                features.trim_end_matches(" (*)").to_string(),
+            )
+        })
+        .collect()
+}
+
+/// The crates shared with the dev-dependencies get the same features in `cargo build`
+/// as in `cargo test`, so the two share one build of them and of this crate (the
+/// feature list in `Cargo.toml` says why).
+#[test]
+fn the_build_and_the_tests_share_their_dependencies_features() {
+    let built = features_by_package("normal,build");
+    let tested = features_by_package("normal,build,dev");
+    let differ: Vec<String> = built
+        .iter()
+        .filter(|(package, features)| tested.get(*package) != Some(*features))
+        .map(|(package, features)| {
+            format!(
+                "{package}: [{features}] built, [{}] tested",
+                tested[package]
+            )
+        })
+        .collect();
+    assert!(
+        differ.is_empty(),
+        "declare these features in Cargo.toml's [dependencies]:\n{}",
+        differ.join("\n")
+    );
 }
