@@ -12,7 +12,10 @@ use std::process::Command;
 use glam::{DVec2, DVec3};
 use serde_json::Value;
 
-use super::{check_dxf_matches_svg, check_svg_sheet, SheetSpec, SheetStats};
+use super::{
+    check_dxf_matches_svg, check_dxf_matches_svg_read_by, check_svg_sheet, DxfReader, SheetSpec,
+    SheetStats,
+};
 use unfold::config::{BuildOptions, Job, ModelOptions};
 use unfold::flatten::{facet_frames, flatten};
 use unfold::mesh::split::SplitReport;
@@ -387,8 +390,12 @@ impl Sheets {
     }
 }
 
+/// Larger DXF files are read by the Rust reader only (unless `UNFOLD_FULL_DXF=1`).
+const EZDXF_MAX_BYTES: u64 = 1 << 20;
+
 /// Checks every SVG of `out` with `check_svg_sheet` (sheet spec from the manifest) and
-/// the DXF files chosen by `dxf` with `check_dxf_matches_svg` against their SVG.
+/// the DXF files chosen by `dxf` against their SVG: each with the Rust reader, and with
+/// ezdxf as well those up to [`EZDXF_MAX_BYTES`] (at least the smallest one).
 pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     let spec = sheet_spec(manifest);
     let names = entry_names(out);
@@ -442,6 +449,19 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     } else {
         vec![&dxf_files[0], &dxf_files[dxf_files.len() - 1]]
     };
+    // ezdxf, the independent reader, takes about 0.7 s per MB: it reads every chosen
+    // file up to EZDXF_MAX_BYTES (the smallest one when all are larger), the Rust reader
+    // every chosen file.
+    let bytes = |name: &String| std::fs::metadata(out.join(name)).map_or(0, |m| m.len());
+    let mut by_ezdxf: BTreeSet<&String> = chosen
+        .iter()
+        .copied()
+        .filter(|n| full || bytes(n) <= EZDXF_MAX_BYTES)
+        .collect();
+    if by_ezdxf.is_empty() {
+        by_ezdxf.extend(chosen.iter().copied().min_by_key(|n| (bytes(n), *n)));
+    }
+    let by_ezdxf = &by_ezdxf;
     // ezdxf runs in child processes: check a few at once.
     let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
     let chunk = chosen.len().div_ceil(workers).max(1);
@@ -455,7 +475,13 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
                         .filter_map(|name| {
                             let svg_name = name.trim_end_matches(".dxf").to_string() + ".svg";
                             let svg = std::fs::read_to_string(out.join(svg_name)).unwrap();
-                            check_dxf_matches_svg(&out.join(name), &svg, spec.height).err()
+                            let path = out.join(name);
+                            if by_ezdxf.contains(name) {
+                                check_dxf_matches_svg(&path, &svg, spec.height).err()
+                            } else {
+                                let rust = DxfReader::Rust;
+                                check_dxf_matches_svg_read_by(rust, &path, &svg, spec.height).err()
+                            }
                         })
                         .collect::<Vec<_>>()
                 })
