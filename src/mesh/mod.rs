@@ -8,7 +8,6 @@ pub mod build;
 pub mod components;
 pub mod decimate;
 pub mod distance;
-pub mod ergs;
 pub mod geometry;
 pub mod halfedge;
 pub mod holes;

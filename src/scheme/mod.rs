@@ -8,6 +8,7 @@
 //! module reaches the schemes only through a [`Registry`].
 
 pub mod edge_panel;
+pub mod ergs;
 pub mod half_edge;
 pub mod net;
 pub mod quad_edge;

@@ -26,9 +26,9 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::ergs::{trace_cycles, WeaveCycle};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
-use crate::mesh::ergs::{trace_cycles, WeaveCycle};
 use crate::mesh::geometry::{planarity_error, vector_area};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
 use crate::option_default::{state_defaults, OptionDefault};

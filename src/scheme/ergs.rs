@@ -10,8 +10,7 @@
 //! `twin(prev(twin(h)))`. A step passes one face corner (at w), named here by the
 //! face half-edge that ends there: h for a left step, `prev(twin(h))` for a right one.
 
-use super::halfedge::Mesh;
-use super::ids::{EdgeId, HalfedgeId};
+use crate::mesh::{EdgeId, HalfedgeId, Mesh};
 
 /// Which face a step follows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
