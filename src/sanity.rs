@@ -379,7 +379,7 @@ const PROBE_SMALLEST: f64 = 0.5;
 /// The job's model repaired as the [`Repairs`] say (on top of its own options) and
 /// simplified to a number of edges as `--target-edges` would, scaled and split as the
 /// scheme needs (`None` when that fails).
-pub type MeshAt<'a> = dyn Fn(usize, Repairs) -> Option<Mesh> + 'a;
+pub type MeshAt<'a> = dyn Fn(usize, Repairs) -> Option<Mesh> + Sync + 'a;
 
 /// Budgets a warning tries ([`checked_budget`]) before it gives up naming one.
 const BUDGET_TRIALS: usize = 10;
@@ -463,51 +463,94 @@ fn rim_lengths(mesh: &Mesh) -> Vec<f64> {
 /// coarse (a panel larger than the sheet, or below the fewest edges the topology
 /// allows) by a larger one, and once both kinds were seen, by the budget halfway
 /// between them on a log scale. `None` when none of [`BUDGET_TRIALS`] builds clean.
+///
+/// Each trial runs beside the one that follows it if it turns out as the last did
+/// (too detailed, as near or as far): most of a trial is simplifying, on one core, so
+/// the search takes about half the time on two. The budgets tried and the one named
+/// are those of the trials one after the other, whatever the number of threads.
 fn checked_budget(
     job: &Job,
     estimate: f64,
     edges: usize,
-    mesh_at: &dyn Fn(usize) -> Option<Mesh>,
+    mesh_at: &(dyn Fn(usize) -> Option<Mesh> + Sync),
 ) -> Option<usize> {
+    let try_budget =
+        |budget: f64| mesh_at(budget as usize).map_or(Trial::TooCoarse, |mesh| trial(job, &mesh));
+    let in_range = |budget: f64| (6.0..edges as f64).contains(&budget);
     let mut budget = round_down_2(estimate.min(edges as f64 * BUDGET_STEP));
-    // The largest budget found too coarse and the smallest found too detailed.
-    let (mut coarse, mut detailed) = (None::<f64>, None::<f64>);
+    let mut search = Search::default();
+    let mut last = Trial::TooDetailed { far: true };
+    let mut ahead: Option<(f64, Trial)> = None;
     for _ in 0..BUDGET_TRIALS {
-        if budget < 6.0 || budget >= edges as f64 {
+        if !in_range(budget) {
             return None;
         }
-        let verdict = mesh_at(budget as usize).map_or(Trial::TooCoarse, |mesh| trial(job, &mesh));
+        let verdict = match ahead.take() {
+            Some((tried, verdict)) if tried == budget => verdict,
+            _ => {
+                let guess = match last {
+                    Trial::TooCoarse => Trial::TooDetailed { far: false },
+                    other => other,
+                };
+                let after = search.after(budget, guess).1.filter(|&b| in_range(b));
+                let (verdict, ahead_verdict) =
+                    rayon::join(|| try_budget(budget), || after.map(|b| (b, try_budget(b))));
+                ahead = ahead_verdict;
+                verdict
+            }
+        };
+        if verdict == Trial::Clean {
+            return Some(budget as usize);
+        }
+        let (next_search, next) = search.after(budget, verdict);
+        search = next_search;
+        last = verdict;
+        budget = next?;
+    }
+    None
+}
+
+/// What a budget search has seen: the largest budget found too coarse and the
+/// smallest found too detailed.
+#[derive(Clone, Copy, Default)]
+struct Search {
+    coarse: Option<f64>,
+    detailed: Option<f64>,
+}
+
+impl Search {
+    /// The search after `budget` gave `verdict` (not clean), and the budget to try
+    /// next (`None` when the search has nowhere left to go).
+    fn after(self, budget: f64, verdict: Trial) -> (Search, Option<f64>) {
+        let mut seen = self;
         let next = match verdict {
-            Trial::Clean => return Some(budget as usize),
+            Trial::Clean => return (seen, None),
             Trial::TooDetailed { far } => {
-                detailed = Some(budget);
-                match coarse {
+                seen.detailed = Some(budget);
+                match self.coarse {
                     Some(low) => (low * budget).sqrt(),
                     None if far => budget * FAR_STEP,
                     None => budget * BUDGET_STEP,
                 }
             }
             Trial::TooCoarse => {
-                coarse = Some(budget);
-                match detailed {
+                seen.coarse = Some(budget);
+                match self.detailed {
                     Some(high) => (high * budget).sqrt(),
                     None => budget / FAR_STEP,
                 }
             }
         };
         let next = round_down_2(next);
-        if next == budget
-            || coarse.is_some_and(|c| next <= c)
-            || detailed.is_some_and(|d| next >= d)
-        {
-            return None;
-        }
-        budget = next;
+        let stuck = next == budget
+            || seen.coarse.is_some_and(|c| next <= c)
+            || seen.detailed.is_some_and(|d| next >= d);
+        (seen, (!stuck).then_some(next))
     }
-    None
 }
 
 /// What one trial budget gave.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Trial {
     /// Nothing to warn of.
     Clean,
@@ -685,6 +728,24 @@ mod tests {
         assert_eq!(round_down_2(1234.0), 1200.0);
         assert_eq!(round_down_2(99.9), 99.0);
         assert_eq!(round_down_2(7.5), 7.0);
+    }
+
+    #[test]
+    fn a_budget_search_steps_down_from_detail_and_up_from_coarseness_then_halves() {
+        let start = Search::default();
+        let far = Trial::TooDetailed { far: true };
+        let near = Trial::TooDetailed { far: false };
+        assert_eq!(start.after(1000.0, far).1, Some(700.0));
+        assert_eq!(start.after(1000.0, near).1, Some(900.0));
+        assert_eq!(start.after(700.0, Trial::TooCoarse).1, Some(1000.0));
+        // Too detailed at 1000, then too coarse at 640: the log midpoint, 800.
+        let (seen, next) = start.after(1000.0, near);
+        assert_eq!(next, Some(900.0));
+        assert_eq!(seen.after(640.0, Trial::TooCoarse).1, Some(800.0));
+        // Between two neighbouring budgets there is nowhere left to go.
+        let (seen, _) = start.after(100.0, near);
+        assert_eq!(seen.after(99.0, Trial::TooCoarse).1, None);
+        assert_eq!(start.after(1000.0, Trial::Clean).1, None);
     }
 
     #[test]
