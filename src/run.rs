@@ -730,11 +730,17 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         warn(warning);
     }
     clock.lap("split");
-    // A mesh the scheme can never build is refused before any budget is tried for it.
-    job.scheme
-        .accepts(&prepared.scheme_mesh.mesh)
-        .map_err(|e| scheme_error(job, e))?;
+    // A mesh the scheme can never build is refused before the long stages, with the
+    // budget that builds it closed where it would be too detailed closed as well.
     let budget = || prepared.clean_budget(job);
+    if let Err(e) = job.scheme.accepts(&prepared.scheme_mesh.mesh) {
+        let fix = crate::sanity::closed_fix(job, &prepared.scheme_mesh.mesh, &budget);
+        return Err(match scheme_error(job, e) {
+            Error::Usage(message) => Error::Usage(message + &fix),
+            Error::Build(message) => Error::Build(message + &fix),
+            other => other,
+        });
+    }
     crate::sanity::check_detail(job, &prepared.scheme_mesh.mesh, &budget)?;
     progress.stage("making the panels");
     let output = scheme(job, &prepared)?;

@@ -175,11 +175,7 @@ pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggesti
     if job.build_anyway {
         return Ok(());
     }
-    let lengths = mesh.sorted_edge_lengths();
-    let Some(&median) = lengths.get(lengths.len() / 2) else {
-        return Ok(());
-    };
-    let Some(buildable) = smallest_buildable_edge(job, mesh).filter(|&b| median < b) else {
+    let Some((median, buildable)) = median_too_short(job, mesh) else {
         return Ok(());
     };
     let what = format!(
@@ -189,6 +185,35 @@ pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggesti
         job.scheme.name()
     );
     too_detailed(job, mesh, &what, true, budget).map(|_| ())
+}
+
+/// The median edge of `mesh` (mm) and the smallest at which the job's panels hold
+/// their ids, when the median is the shorter.
+fn median_too_short(job: &Job, mesh: &Mesh) -> Option<(f64, f64)> {
+    let lengths = mesh.sorted_edge_lengths();
+    let median = *lengths.get(lengths.len() / 2)?;
+    let buildable = smallest_buildable_edge(job, mesh).filter(|&b| median < b)?;
+    Some((median, buildable))
+}
+
+/// The fix named beside a refusal of a scheme that cannot build an open mesh: when
+/// the model, closed, would be too detailed for its size, the budget tried with its
+/// holes closed, e.g. "; closed, it is too detailed for its size: try --fill-holes
+/// --target-edges 600 (or --fill-holes --target-edges auto)". Empty otherwise.
+pub fn closed_fix(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggestion>) -> String {
+    let open = !mesh.boundary_loops().is_empty();
+    if !open || job.model.fill_holes || job.build_anyway || median_too_short(job, mesh).is_none() {
+        return String::new();
+    }
+    match budget().filter(|s| s.repairs.fill_holes) {
+        Some(Suggestion { edges, repairs }) => {
+            let flags = repairs.flags();
+            format!(
+                "; closed, it is too detailed for its size: try {flags}--target-edges {edges} (or {flags}--target-edges auto)"
+            )
+        }
+        None => String::new(),
+    }
 }
 
 /// What a model too detailed for its size gets: a stop before the long stages (exit
@@ -418,8 +443,10 @@ pub fn clean_budget(
     let can_fill = !job.model.fill_holes && !rims.is_empty();
     let rim_too_short = ids_edge.is_some_and(|edge| rims.iter().any(|&rim| rim < RIM_EDGES * edge));
     let can_weld = can_weld && !job.model.weld;
+    // A scheme that cannot build the model open (woven) is tried on it closed only.
+    let open_refused = can_fill && job.scheme.accepts(mesh).is_err();
     let mut tries = Vec::new();
-    if !(can_fill && rim_too_short) {
+    if !(can_fill && (rim_too_short || open_refused)) {
         tries.push(Repairs::default());
     }
     if can_fill {

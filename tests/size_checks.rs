@@ -405,14 +405,15 @@ fn open_dome(n: usize) -> String {
 }
 
 #[test]
-fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
-    // Far too detailed for woven panels at 2 ft, and open: no budget could weave it,
-    // so the refusal names the holes, not a budget.
+fn a_scheme_that_cannot_build_the_shape_says_so_and_names_the_closed_fix() {
+    // Open, and far too detailed for woven panels at 2 ft: the refusal names the
+    // holes, and the budget that, tried with them closed, weaves it clean.
     let tmp = TempDir::new().unwrap();
     let dome = tmp.path().join("dome.obj");
     std::fs::write(&dome, open_dome(120)).unwrap();
     let out = tmp.path().join("out");
-    let run = build(&dome, &out, &["--scheme", "woven", "--size", "2ft"]);
+    let args = ["--scheme", "woven", "--size", "2ft"];
+    let run = build(&dome, &out, &args);
     assert_refused(
         "open dome, woven",
         &run,
@@ -420,14 +421,26 @@ fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
         &[
             "needs a closed mesh and this one has 1 hole",
             "(--fill-holes)",
+            "closed, it is too detailed for its size: try --fill-holes --target-edges ",
+            "(or --fill-holes --target-edges auto)",
         ],
     );
-    assert!(
-        !run.stderr.contains("too detailed") && !run.stderr.contains("--target-edges"),
-        "{}",
-        run.stderr
-    );
+    let budget = number_after(&run.stderr, "try --fill-holes --target-edges ")
+        .unwrap()
+        .to_string();
+    let mut fixed = args.to_vec();
+    fixed.extend([
+        "--fill-holes",
+        "--target-edges",
+        &budget,
+        "--nester",
+        "shelf",
+    ]);
+    let run = build(&dome, &out, &fixed);
+    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
     // The same dome with the half-edge scheme is only too detailed: a budget is named.
+    let out = tmp.path().join("half-edge");
     let run = build(&dome, &out, &["--scheme", "half-edge", "--size", "2ft"]);
     assert_refused(
         "open dome, half-edge",
@@ -435,6 +448,7 @@ fn a_scheme_that_cannot_build_the_shape_says_so_before_any_budget() {
         &out,
         &["too detailed", "--target-edges "],
     );
+    assert!(!run.stderr.contains("--fill-holes"), "{}", run.stderr);
 }
 
 /// A UV sphere of `rings` × `segments` whose northmost ring lies `hole` (radians) from
