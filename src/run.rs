@@ -302,6 +302,13 @@ fn model_at(job: &Job, edges: usize, repairs: crate::sanity::Repairs) -> Option<
     let mut trial = job.clone();
     trial.model.budget = Some(crate::mesh::simplify::Budget::Edges(edges));
     trial.model.auto_budget = false;
+    repaired(&trial, repairs)
+}
+
+/// The job's model repaired as `repairs` say (on top of its own options), scaled and
+/// split for the scheme.
+fn repaired(job: &Job, repairs: crate::sanity::Repairs) -> Option<crate::mesh::Mesh> {
+    let mut trial = job.clone();
     trial.model.weld |= repairs.weld;
     trial.model.fill_holes |= repairs.fill_holes;
     let loaded = load(&trial).ok()?;
@@ -734,7 +741,14 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     // budget that builds it closed where it would be too detailed closed as well.
     let budget = || prepared.clean_budget(job);
     if let Err(e) = job.scheme.accepts(&prepared.scheme_mesh.mesh) {
-        let fix = crate::sanity::closed_fix(job, &prepared.scheme_mesh.mesh, &budget);
+        let closed = || {
+            let fill = crate::sanity::Repairs {
+                weld: false,
+                fill_holes: true,
+            };
+            repaired(job, fill)
+        };
+        let fix = crate::sanity::closed_fix(job, &prepared.scheme_mesh.mesh, &closed, &budget);
         return Err(match scheme_error(job, e) {
             Error::Usage(message) => Error::Usage(message + &fix),
             Error::Build(message) => Error::Build(message + &fix),

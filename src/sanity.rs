@@ -197,19 +197,30 @@ fn median_too_short(job: &Job, mesh: &Mesh) -> Option<(f64, f64)> {
 }
 
 /// The fix named beside a refusal of a scheme that cannot build an open mesh: when
-/// the model, closed, would be too detailed for its size, the budget tried with its
-/// holes closed, e.g. "; closed, it is too detailed for its size: try --fill-holes
-/// --target-edges 600 (or --fill-holes --target-edges auto)". Empty otherwise.
-pub fn closed_fix(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggestion>) -> String {
+/// the model closed (`closed`, at full resolution) would not build clean, the budget
+/// tried with its holes closed, e.g. "; closed, it builds clean at fewer edges: try
+/// --fill-holes --target-edges 600 (or --fill-holes --target-edges auto)". Empty
+/// otherwise. A model whose median edge is already too short is not built closed
+/// first: that build would take long to say so.
+pub fn closed_fix(
+    job: &Job,
+    mesh: &Mesh,
+    closed: &dyn Fn() -> Option<Mesh>,
+    budget: &dyn Fn() -> Option<Suggestion>,
+) -> String {
     let open = !mesh.boundary_loops().is_empty();
-    if !open || job.model.fill_holes || job.build_anyway || median_too_short(job, mesh).is_none() {
+    if !open || job.model.fill_holes || job.build_anyway {
+        return String::new();
+    }
+    let clean_closed = || closed().is_some_and(|m| trial(job, &m) == Trial::Clean);
+    if median_too_short(job, mesh).is_none() && clean_closed() {
         return String::new();
     }
     match budget().filter(|s| s.repairs.fill_holes) {
         Some(Suggestion { edges, repairs }) => {
             let flags = repairs.flags();
             format!(
-                "; closed, it is too detailed for its size: try {flags}--target-edges {edges} (or {flags}--target-edges auto)"
+                "; closed, it builds clean at fewer edges: try {flags}--target-edges {edges} (or {flags}--target-edges auto)"
             )
         }
         None => String::new(),

@@ -421,7 +421,7 @@ fn a_scheme_that_cannot_build_the_shape_says_so_and_names_the_closed_fix() {
         &[
             "needs a closed mesh and this one has 1 hole",
             "(--fill-holes)",
-            "closed, it is too detailed for its size: try --fill-holes --target-edges ",
+            "closed, it builds clean at fewer edges: try --fill-holes --target-edges ",
             "(or --fill-holes --target-edges auto)",
         ],
     );
