@@ -302,13 +302,12 @@ fn model_at(job: &Job, edges: usize, repairs: crate::sanity::Repairs) -> Option<
     let mut trial = job.clone();
     trial.model.budget = Some(crate::mesh::simplify::Budget::Edges(edges));
     trial.model.auto_budget = false;
-    repaired(&trial, repairs)
+    repaired(trial, repairs)
 }
 
-/// The job's model repaired as `repairs` say (on top of its own options), scaled and
-/// split for the scheme.
-fn repaired(job: &Job, repairs: crate::sanity::Repairs) -> Option<crate::mesh::Mesh> {
-    let mut trial = job.clone();
+/// The model of `trial` repaired as `repairs` say (on top of its own options), scaled
+/// and split for the scheme.
+fn repaired(mut trial: Job, repairs: crate::sanity::Repairs) -> Option<crate::mesh::Mesh> {
     trial.model.weld |= repairs.weld;
     trial.model.fill_holes |= repairs.fill_holes;
     let loaded = load(&trial).ok()?;
@@ -737,8 +736,8 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
         warn(warning);
     }
     clock.lap("split");
-    // A mesh the scheme can never build is refused before the long stages, with the
-    // budget that builds it closed where it would be too detailed closed as well.
+    // A mesh the scheme can never build is refused before the long stages, naming
+    // the budget tried with its holes closed where closing them alone would not do.
     let budget = || prepared.clean_budget(job);
     if let Err(e) = job.scheme.accepts(&prepared.scheme_mesh.mesh) {
         let closed = || {
@@ -746,7 +745,7 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
                 weld: false,
                 fill_holes: true,
             };
-            repaired(job, fill)
+            repaired(job.clone(), fill)
         };
         let fix = crate::sanity::closed_fix(job, &prepared.scheme_mesh.mesh, &closed, &budget);
         return Err(match scheme_error(job, e) {

@@ -517,6 +517,7 @@ fn checked_budget(
     let in_range = |budget: f64| (6.0..edges as f64).contains(&budget);
     let mut budget = round_down_2(estimate.min(edges as f64 * BUDGET_STEP));
     let mut search = Search::default();
+    // Before any trial, the guess is that the first budget is far from clean.
     let mut last = Trial::TooDetailed { far: true };
     let mut ahead: Option<(f64, Trial)> = None;
     for _ in 0..BUDGET_TRIALS {

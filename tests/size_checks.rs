@@ -46,6 +46,32 @@ fn assert_refused(case: &str, run: &Run, out: &Path, says: &[&str]) {
     assert!(!out.exists(), "{case}: {} was written", out.display());
 }
 
+/// Runs the fix a refusal named, `repairs` then `--target-edges N` (N read from the
+/// refusal after them), on top of `args`, and asserts that it builds with no warning.
+/// Returns the run.
+fn assert_named_fix_builds_clean(
+    model: &Path,
+    out: &Path,
+    args: &[&str],
+    refusal: &Run,
+    repairs: &[&str],
+) -> Run {
+    let named = format!(
+        "{}--target-edges ",
+        repairs.iter().map(|r| format!("{r} ")).collect::<String>()
+    );
+    let budget = number_after(&refusal.stderr, &named)
+        .unwrap_or_else(|| panic!("no `{named}N` in: {}", refusal.stderr))
+        .to_string();
+    let mut fixed = args.to_vec();
+    fixed.extend(repairs);
+    fixed.extend(["--target-edges", &budget]);
+    let run = build(model, out, &fixed);
+    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    run
+}
+
 #[test]
 fn a_model_in_metres_without_size_is_refused_with_the_units_that_fit() {
     let tmp = TempDir::new().unwrap();
@@ -425,20 +451,8 @@ fn a_scheme_that_cannot_build_the_shape_says_so_and_names_the_closed_fix() {
             "(or --fill-holes --target-edges auto)",
         ],
     );
-    let budget = number_after(&run.stderr, "try --fill-holes --target-edges ")
-        .unwrap()
-        .to_string();
-    let mut fixed = args.to_vec();
-    fixed.extend([
-        "--fill-holes",
-        "--target-edges",
-        &budget,
-        "--nester",
-        "shelf",
-    ]);
-    let run = build(&dome, &out, &fixed);
-    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
-    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    let shelf: Vec<&str> = args.iter().copied().chain(["--nester", "shelf"]).collect();
+    assert_named_fix_builds_clean(&dome, &out, &shelf, &run, &["--fill-holes"]);
     // The same dome with the half-edge scheme is only too detailed: a budget is named.
     let out = tmp.path().join("half-edge");
     let run = build(&dome, &out, &["--scheme", "half-edge", "--size", "2ft"]);
@@ -515,15 +529,8 @@ fn a_hole_too_small_for_any_budget_gets_a_fix_that_closes_it() {
             "(or --fill-holes --target-edges auto)",
         ],
     );
-    let budget = number_after(&run.stderr, "--fill-holes --target-edges ")
-        .unwrap()
-        .to_string();
     // The fix named, run, builds with no warning; its note says what was closed.
-    let mut fixed = args.to_vec();
-    fixed.extend(["--fill-holes", "--target-edges", &budget]);
-    let run = build(&ball, &out, &fixed);
-    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
-    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    let run = assert_named_fix_builds_clean(&ball, &out, &args, &run, &["--fill-holes"]);
     assert!(
         run.stdout
             .contains("--fill-holes closed 1 hole with one face each")
@@ -586,14 +593,7 @@ fn the_teapot_stops_naming_the_repairs_its_open_seams_need() {
         &out,
         &["try --weld --fill-holes --target-edges "],
     );
-    let budget = number_after(&run.stderr, "--weld --fill-holes --target-edges ")
-        .unwrap()
-        .to_string();
-    let mut fixed = args.to_vec();
-    fixed.extend(["--weld", "--fill-holes", "--target-edges", &budget]);
-    let run = build(&teapot, &out, &fixed);
-    assert_eq!(run.code, Some(0), "at {budget}: {}", run.stderr);
-    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    assert_named_fix_builds_clean(&teapot, &out, &args, &run, &["--weld", "--fill-holes"]);
 }
 
 #[test]

@@ -449,9 +449,7 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     } else {
         vec![&dxf_files[0], &dxf_files[dxf_files.len() - 1]]
     };
-    // ezdxf, the independent reader, takes about 0.7 s per MB: it reads every chosen
-    // file up to EZDXF_MAX_BYTES (the smallest one when all are larger), the Rust reader
-    // every chosen file.
+    // ezdxf, the independent reader, takes about 0.7 s per MB.
     let bytes = |name: &String| std::fs::metadata(out.join(name)).map_or(0, |m| m.len());
     let mut by_ezdxf: BTreeSet<&String> = chosen
         .iter()
