@@ -83,26 +83,33 @@ pub fn load_model(
     Ok((raw, prepared))
 }
 
-/// `--min-component`: removes the components of fewer than `min_faces` faces, with a
-/// note; refuses a model where nothing would be left.
-/// `--fill-holes`: every boundary loop closed by one face, with a note.
+/// `--fill-holes`: every boundary loop closed ([`mesh::holes::fill_holes`]), with a note.
 fn fill_holes(prepared: &mut PreparedModel) -> Result<()> {
     let filled = mesh::holes::fill_holes(&prepared.mesh)
         .map_err(|e| error::Error::internal("closing the holes", e))?;
     if let Some((closed, filled)) = filled {
         prepared.notes.push(Note {
             kind: "filled-holes",
-            message: format!(
-                "--fill-holes closed {} with one face each (the largest has {} edges)",
-                crate::units::count_of(filled.holes, "hole"),
-                filled.largest
-            ),
+            message: match filled.joined {
+                0 => format!(
+                    "--fill-holes closed {} with one face each (the largest has {} edges)",
+                    crate::units::count_of(filled.holes, "hole"),
+                    filled.largest
+                ),
+                joined => format!(
+                    "--fill-holes closed {} (the largest has {} edges): {joined} of them open seams whose rims meet themselves, joined where they meet and capped only where they enclose area, the others with one face each",
+                    crate::units::count_of(filled.holes, "hole"),
+                    filled.largest
+                ),
+            },
         });
         prepared.mesh = closed;
     }
     Ok(())
 }
 
+/// `--min-component`: removes the components of fewer than `min_faces` faces, with a
+/// note; refuses a model where nothing would be left.
 fn drop_small_components(
     path: &Path,
     min_faces: usize,

@@ -597,6 +597,55 @@ fn the_teapot_stops_naming_the_repairs_its_open_seams_need() {
 }
 
 #[test]
+fn the_teapots_open_seams_are_joined_shut_and_auto_weaves_it() {
+    let Some(shared) = shared_models("the_teapots_open_seams_are_joined_shut_and_auto_weaves_it")
+    else {
+        return;
+    };
+    // The teapot's patches meet along open seams: rims that run out and back along
+    // one line. Capped with one face each, they gave the woven ribbons crossings of
+    // no area; joined where the rims meet, the teapot weaves at the budget auto picks.
+    let teapot = shared.join("teapot.obj");
+    let run = finish(
+        unfold_command()
+            .args(["inspect", "--fill-holes"])
+            .arg(&teapot),
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    for fact in [
+        "boundary loops 0",
+        "--fill-holes closed 25 holes (the largest has 98 edges): 11 of them open seams whose rims meet themselves, joined where they meet",
+        "genus 0  euler 38  components 19",
+    ] {
+        assert!(run.stdout.contains(fact), "{fact}: {}", run.stdout);
+    }
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let run = build(
+        &teapot,
+        &out,
+        &[
+            "--scheme",
+            "woven",
+            "--size",
+            "4ft",
+            "--nester",
+            "shelf",
+            "--fill-holes",
+            "--target-edges",
+            "auto",
+        ],
+    );
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to "),
+        "{}",
+        run.stderr
+    );
+}
+
+#[test]
 fn auto_shows_only_the_warnings_of_the_build_it_keeps() {
     let Some(shared) = shared_models("auto_shows_only_the_warnings_of_the_build_it_keeps") else {
         return;

@@ -900,6 +900,10 @@ struct Limits {
     curl: f64,
 }
 
+/// A ribbon facet whose area is below this fraction of its crossing's squared
+/// diameter has no direction to unroll in.
+const DEGENERATE_AREA: f64 = 1e-9;
+
 /// The face pieces of corner `i` (without its edge piece), as ring indices.
 fn face_part(ribbon: &Ribbon, i: usize) -> std::ops::Range<usize> {
     let all = ribbon.corner_pieces(i);
@@ -989,10 +993,22 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
                 let points: Vec<DVec3> = (start..=start + pieces)
                     .flat_map(|l| r.lines[l % ring])
                     .collect();
+                let across = crate::mesh::geometry::diameter(&points);
+                let flat_facet = (start..start + pieces).any(|k| {
+                    let k = k % ring;
+                    r.facets[k].iter().any(|facet| {
+                        let corners = facet.iter().map(|&c| r.point(k, c));
+                        vector_area(corners).length() <= DEGENERATE_AREA * across * across
+                    })
+                });
+                let why = if flat_facet {
+                    "crosses a face of almost no area (three corners in a line), which cannot be unrolled; simplify the model (--target-edges) or mend that face"
+                } else {
+                    "does not fit the sheet; use a larger --sheet or a smaller --size"
+                };
                 SchemeError::Model(format!(
-                    "cycle {}: one edge crossing of its ribbon is {:.1} mm across and does not fit the sheet; use a larger --sheet or a smaller --size",
+                    "cycle {}: one edge crossing of its ribbon is {across:.1} mm across and {why}",
                     cycle_id(r.cycle),
-                    crate::mesh::geometry::diameter(&points)
                 ))
             })
         })
