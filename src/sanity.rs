@@ -496,8 +496,9 @@ fn rim_lengths(mesh: &Mesh) -> Vec<f64> {
 /// A budget a warning may suggest because it was tried: the first at which the model,
 /// simplified as `--target-edges` would do it (`mesh_at`), builds clean ([`trial`]).
 /// The first tried is `estimate` (or a tenth below the model's `edges`, where that is
-/// fewer); a budget too detailed is followed by a smaller one (by a tenth, or by 30 %
-/// when more than [`FAR_SHORT`] of the panels or connections go without), one too
+/// fewer); a budget too detailed is followed by a smaller one (by 30 % when more than
+/// [`FAR_SHORT`] of the panels or connections go without, else by a tenth, by 19 % after
+/// two such in a row, by 27 % after three, and so on), one too
 /// coarse (a panel larger than the sheet, or below the fewest edges the topology
 /// allows) by a larger one, and once both kinds were seen, by the budget halfway
 /// between them on a log scale. `None` when none of [`BUDGET_TRIALS`] builds clean.
@@ -549,12 +550,14 @@ fn checked_budget(
     None
 }
 
-/// What a budget search has seen: the largest budget found too coarse and the
-/// smallest found too detailed.
+/// What a budget search has seen: the largest budget found too coarse, the smallest
+/// found too detailed, and how many budgets in a row were found too detailed but
+/// near clean.
 #[derive(Clone, Copy, Default)]
 struct Search {
     coarse: Option<f64>,
     detailed: Option<f64>,
+    near_run: i32,
 }
 
 impl Search {
@@ -566,13 +569,17 @@ impl Search {
             Trial::Clean => return (seen, None),
             Trial::TooDetailed { far } => {
                 seen.detailed = Some(budget);
+                seen.near_run = if far { 0 } else { self.near_run + 1 };
                 match self.coarse {
                     Some(low) => (low * budget).sqrt(),
                     None if far => budget * FAR_STEP,
-                    None => budget * BUDGET_STEP,
+                    // Each near budget in a row steps further: a model that stays
+                    // near clean for a tenth fewer edges is seldom clean at the next.
+                    None => budget * BUDGET_STEP.powi(seen.near_run),
                 }
             }
             Trial::TooCoarse => {
+                seen.near_run = 0;
                 seen.coarse = Some(budget);
                 match self.detailed {
                     Some(high) => (high * budget).sqrt(),
@@ -781,6 +788,13 @@ mod tests {
         let (seen, next) = start.after(1000.0, near);
         assert_eq!(next, Some(900.0));
         assert_eq!(seen.after(640.0, Trial::TooCoarse).1, Some(800.0));
+        // Near budgets in a row step by a tenth, then by 19 %, then by 27 %.
+        let (seen, next) = seen.after(900.0, near);
+        assert_eq!(next, Some(720.0));
+        assert_eq!(seen.after(720.0, near).1, Some(520.0));
+        // A far budget ends the run.
+        let (seen, _) = seen.after(720.0, far);
+        assert_eq!(seen.after(500.0, near).1, Some(450.0));
         // Between two neighbouring budgets there is nowhere left to go.
         let (seen, _) = start.after(100.0, near);
         assert_eq!(seen.after(99.0, Trial::TooCoarse).1, None);

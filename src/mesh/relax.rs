@@ -316,10 +316,15 @@ fn move_vertices(
     moved
 }
 
-/// The smallest angle of a triangle, in radians.
+/// The smallest angle of a triangle, in radians: the arccosine of the largest of its
+/// angles' cosines (one arccosine, not three; it falls as the cosine rises).
 fn smallest_angle([a, b, c]: [DVec3; 3]) -> f64 {
-    let at = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p);
-    at(a, b, c).min(at(b, c, a)).min(at(c, a, b))
+    let cosine = |p: DVec3, q: DVec3, r: DVec3| {
+        let (u, v) = (q - p, r - p);
+        u.dot(v) / (u.length_squared() * v.length_squared()).sqrt()
+    };
+    let largest = cosine(a, b, c).max(cosine(b, c, a)).max(cosine(c, a, b));
+    largest.clamp(-1.0, 1.0).acos()
 }
 
 /// One sweep of edge flips, in face order: the edge between triangles (a, b, c) and
@@ -370,15 +375,18 @@ fn flip_edges(
             let p = |v: u32| positions[v as usize];
             let (old1, old2) = ([p(a), p(b), p(c)], [p(b), p(a), p(d)]);
             let (new1, new2) = ([p(a), p(d), p(c)], [p(d), p(b), p(c)]);
-            let gain = smallest_angle(new1).min(smallest_angle(new2))
-                - smallest_angle(old1).min(smallest_angle(old2));
             let (n1, n2) = (area(old1), area(old2));
             let flat = n1.normalize_or_zero().dot(n2.normalize_or_zero()) >= FLIP_FLATNESS;
             // The new faces face the way the old ones did before relaxing, and keep that
             // direction as the one no later move may turn them from.
             let before = (initial_area[f] + initial_area[g]).normalize_or_zero();
             let (a1, a2) = (area(new1), area(new2));
-            if gain < FLIP_GAIN || !flat || a1.dot(before) <= 0.0 || a2.dot(before) <= 0.0 {
+            if !flat || a1.dot(before) <= 0.0 || a2.dot(before) <= 0.0 {
+                continue;
+            }
+            let gain = smallest_angle(new1).min(smallest_angle(new2))
+                - smallest_angle(old1).min(smallest_angle(old2));
+            if gain < FLIP_GAIN {
                 continue;
             }
             let Some((changed, delta)) = deviation
