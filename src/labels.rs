@@ -46,7 +46,9 @@ pub const LABEL_GAP: f64 = 0.4;
 /// left out. Panel ids go first, then partner ids, then marks, so the important ones
 /// get the room. Labels of one kind share one height where room allows: when a fit
 /// gives them different heights, they are fitted again at most at the smallest, and
-/// the new fit is kept unless it leaves more of some kind out.
+/// the new fit is kept unless it leaves more of some kind out. No label is larger
+/// than the panel's own id, which a builder looks for first: where one would be, the
+/// others are fitted again at most at the id's height.
 pub fn fit_labels(
     panel: &mut FlatPanel,
     source: PanelRef,
@@ -55,17 +57,11 @@ pub fn fit_labels(
 ) -> LeftOut {
     let mut chosen = fit_pass(panel, source, frames, options, [f64::INFINITY; 3]);
     for _ in 0..HEIGHT_PASSES {
-        let mut smallest = [f64::INFINITY; 3];
-        let mut largest = [0.0f64; 3];
-        for label in &chosen.labels {
-            let k = kind_index(label.kind);
-            smallest[k] = smallest[k].min(label.height);
-            largest[k] = largest[k].max(label.height);
-        }
-        if (0..3).all(|k| largest[k] <= smallest[k] * (1.0 + 1e-9)) {
+        let caps = height_caps(&chosen.labels);
+        if within(&chosen.labels, caps) {
             break;
         }
-        let next = fit_pass(panel, source, frames, options, smallest);
+        let next = fit_pass(panel, source, frames, options, caps);
         let keeps_all = LabelKind::ALL
             .into_iter()
             .all(|kind| next.dropped.of(kind) <= chosen.dropped.of(kind));
@@ -74,8 +70,45 @@ pub fn fit_labels(
         }
         chosen = next;
     }
+    // Kept even if it leaves a partner id out: an id smaller than the labels beside
+    // it reads as one of them.
+    let caps = id_caps(&chosen.labels);
+    if !within(&chosen.labels, caps) {
+        chosen = fit_pass(panel, source, frames, options, caps);
+    }
     panel.labels = chosen.labels;
     chosen.dropped
+}
+
+/// The height each kind of label is fitted at most at in the next pass: its smallest
+/// height now (one height per kind), and for the others no more than the panel's id.
+fn height_caps(labels: &[FlatLabel]) -> [f64; 3] {
+    let mut smallest = [f64::INFINITY; 3];
+    for label in labels {
+        let k = kind_index(label.kind);
+        smallest[k] = smallest[k].min(label.height);
+    }
+    let id = smallest[kind_index(LabelKind::Panel)];
+    smallest.map(|cap| cap.min(id))
+}
+
+/// No cap for the id; the other kinds at most at the id's height.
+fn id_caps(labels: &[FlatLabel]) -> [f64; 3] {
+    let id = labels
+        .iter()
+        .filter(|l| l.kind == LabelKind::Panel)
+        .map(|l| l.height)
+        .fold(f64::INFINITY, f64::min);
+    let mut caps = [id; 3];
+    caps[kind_index(LabelKind::Panel)] = f64::INFINITY;
+    caps
+}
+
+/// Whether every label is at most its kind's cap (to rounding).
+fn within(labels: &[FlatLabel], caps: [f64; 3]) -> bool {
+    labels
+        .iter()
+        .all(|l| l.height <= caps[kind_index(l.kind)] * (1.0 + 1e-9))
 }
 
 /// Slot of a kind in per-kind arrays.
@@ -424,5 +457,56 @@ mod tests {
         assert_eq!(flat_pruned.labels.len(), 2, "{:?}", flat_pruned.labels);
         assert_eq!(out_pruned, out_full);
         assert_eq!(out_full.total(), 2);
+    }
+
+    #[test]
+    fn no_label_is_larger_than_the_panels_own_id() {
+        // A 20 mm square beside a 5 mm wide strip in its plane; the id is wanted on
+        // the strip, where it fits only small, and a partner id 4 mm high on the square.
+        let panel = Panel::new(
+            Source::edge(7),
+            vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(20.0, 0.0, 0.0),
+                DVec3::new(20.0, 20.0, 0.0),
+                DVec3::new(0.0, 20.0, 0.0),
+                DVec3::new(25.0, 0.0, 0.0),
+                DVec3::new(25.0, 20.0, 0.0),
+            ],
+            [vec![0, 1, 2, 3], vec![1, 4, 5, 2]].into_iter().collect(),
+            Vec::new(),
+            vec![
+                label(
+                    Name::edge(7),
+                    LabelKind::Panel,
+                    1,
+                    4.0,
+                    DVec3::new(22.5, 10.0, 0.0),
+                ),
+                label(
+                    Name::edge(123),
+                    LabelKind::Partner,
+                    0,
+                    4.0,
+                    DVec3::new(10.0, 10.0, 0.0),
+                ),
+            ],
+        );
+        let (flat, left_out) = unroll_and_fit(&panel, LabelOptions::default()).unwrap();
+        assert_eq!(left_out.total(), 0);
+        let height = |kind: LabelKind| {
+            flat.labels
+                .iter()
+                .find(|l| l.kind == kind)
+                .map(|l| l.height)
+                .unwrap()
+        };
+        let id = height(LabelKind::Panel);
+        assert!(id < 4.0 * SHRINK, "the id is on the strip: {id} mm");
+        assert!(
+            height(LabelKind::Partner) <= id * (1.0 + 1e-9),
+            "{:?}",
+            flat.labels
+        );
     }
 }

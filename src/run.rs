@@ -264,9 +264,7 @@ impl Prepared {
     /// found (by trial builds) the first time a warning asks.
     pub fn clean_budget(&self, job: &Job) -> Option<crate::sanity::Suggestion> {
         *self.clean_budget.get_or_init(|| {
-            crate::sanity::clean_budget(job, &self.scheme_mesh.mesh, self.can_weld, &|n, r| {
-                model_at(job, n, r)
-            })
+            crate::sanity::clean_budget(job, &self.scheme_mesh.mesh, self.can_weld, &model_at)
         })
     }
 }

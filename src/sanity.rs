@@ -217,8 +217,8 @@ pub fn closed_fix(
         return String::new();
     }
     match budget().filter(|s| s.repairs.fill_holes) {
-        Some(Suggestion { edges, repairs }) => {
-            let flags = repairs.flags();
+        Some(suggestion) => {
+            let (flags, edges) = (suggestion.flags(), suggestion.edges);
             format!(
                 "; closed, it builds clean at fewer edges: try {flags}--target-edges {edges} (or {flags}--target-edges auto)"
             )
@@ -248,7 +248,7 @@ fn too_detailed(
         return Ok(warning);
     }
     let auto = match suggestion {
-        Some(Suggestion { repairs, .. }) => format!(" (or {}--target-edges auto)", repairs.flags()),
+        Some(suggestion) => format!(" (or {}--target-edges auto)", suggestion.flags()),
         None => String::new(),
     };
     Err(Error::TooDetailed {
@@ -258,19 +258,31 @@ fn too_detailed(
         ),
         // `auto` takes only a budget that needs no other option.
         budget: suggestion
-            .filter(|s| s.repairs == Repairs::default())
+            .filter(|s| s.repairs == Repairs::default() && s.size.is_none())
             .map(|s| s.edges),
     })
 }
 
 /// A fix that was tried: the model, repaired as `repairs` say, simplified to `edges`
-/// builds clean.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// (and built at `size`, where given) builds clean.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Suggestion {
     /// The `--target-edges` budget.
     pub edges: usize,
     /// The repairs it needs that the job did not ask for.
     pub repairs: Repairs,
+    /// The `--size` (mm) it needs, when no budget builds the model clean at the job's.
+    pub size: Option<f64>,
+}
+
+impl Suggestion {
+    /// The options besides the budget, each followed by a space (empty for none).
+    pub fn flags(&self) -> String {
+        let size = self
+            .size
+            .map_or(String::new(), |mm| format!("--size {} ", length_text(mm)));
+        size + &self.repairs.flags()
+    }
 }
 
 /// Repairs a suggested budget may need beyond the job's own options: the rims of a
@@ -311,11 +323,15 @@ impl Repairs {
 /// edges reach the smallest edge at which the scheme's panels carry their labels.
 fn detail_fixes(job: &Job, mesh: &Mesh, suggestion: Option<Suggestion>) -> String {
     let mut fixes = Vec::new();
-    if let Some(Suggestion { edges, repairs }) = suggestion {
+    if let Some(suggestion) = suggestion {
+        let why = match suggestion.size {
+            Some(_) => " (at the size asked, no budget gives every panel its id and holes)",
+            None => suggestion.repairs.reason(),
+        };
         fixes.push(format!(
-            "{}--target-edges {edges}{}",
-            repairs.flags(),
-            repairs.reason()
+            "{}--target-edges {}{why}",
+            suggestion.flags(),
+            suggestion.edges,
         ));
     }
     let lengths = mesh.sorted_edge_lengths();
@@ -415,7 +431,7 @@ const PROBE_SMALLEST: f64 = 0.5;
 /// The job's model repaired as the [`Repairs`] say (on top of its own options) and
 /// simplified to a number of edges as `--target-edges` would, scaled and split as the
 /// scheme needs (`None` when that fails).
-pub type MeshAt<'a> = dyn Fn(usize, Repairs) -> Option<Mesh> + Sync + 'a;
+pub type MeshAt<'a> = dyn Fn(&Job, usize, Repairs) -> Option<Mesh> + Sync + 'a;
 
 /// Budgets a warning tries ([`checked_budget`]) before it gives up naming one.
 const BUDGET_TRIALS: usize = 10;
@@ -424,7 +440,47 @@ const BUDGET_TRIALS: usize = 10;
 /// few sliver faces a simplification leaves, so the steps are small.
 const BUDGET_STEP: f64 = 0.9;
 
-/// The budget the warnings suggest, tried: the model simplified to it builds clean
+/// The fix the warnings suggest, tried: a budget at the job's size
+/// ([`budget_at_size`]), or where none builds clean (at the fewest edges its topology
+/// allows, some faces are still too thin for a hole), a larger size with the budget
+/// that builds it clean there: one and a half, two, then three times the size. A model
+/// of more than [`SIZE_SEARCH_EDGES`] edges, or built with `--scale`, is not searched
+/// at larger sizes.
+pub fn clean_budget(
+    job: &Job,
+    mesh: &Mesh,
+    can_weld: bool,
+    mesh_at: &MeshAt,
+) -> Option<Suggestion> {
+    if let Some(suggestion) = budget_at_size(job, mesh, can_weld, mesh_at) {
+        return Some(suggestion);
+    }
+    if mesh.edge_count() > SIZE_SEARCH_EDGES || job.model.scaling.scale != 1.0 {
+        return None;
+    }
+    let built = mesh.longest_side();
+    LARGER_SIZES.iter().find_map(|&factor| {
+        // The size as the message prints it, so that the fix tried is the one named.
+        let size = crate::units::parse_length(&length_text(built * factor)).ok()?;
+        let mut larger = job.clone();
+        larger.model.scaling.size = Some(size);
+        let mut scaled = mesh.clone();
+        scaled.scale(size / built);
+        budget_at_size(&larger, &scaled, can_weld, mesh_at).map(|found| Suggestion {
+            size: Some(size),
+            ..found
+        })
+    })
+}
+
+/// Factors of the job's size tried when no budget builds the model clean at it.
+const LARGER_SIZES: [f64; 3] = [1.5, 2.0, 3.0];
+
+/// The most edges of a model searched at larger sizes: each search simplifies it
+/// again, and a scan of hundreds of thousands of edges would take seconds a trial.
+const SIZE_SEARCH_EDGES: usize = 50_000;
+
+/// The budget the warnings suggest at the job's size, tried: the model simplified to it builds clean
 /// ([`trial`]). A budget makes even triangles, so the first tried is the number
 /// of edges whose triangles, [`SPREAD_MARGIN`] times the smallest that hold every
 /// panel's id (and every fastener hole), cover the model's area.
@@ -434,12 +490,7 @@ const BUDGET_STEP: f64 = 0.9;
 /// parts welded as well (`--weld`). A model with a hole whose rim is shorter than
 /// three edges that hold ids is tried with its holes closed straight away: no budget
 /// could build it open. `can_weld` says whether welding would join anything.
-pub fn clean_budget(
-    job: &Job,
-    mesh: &Mesh,
-    can_weld: bool,
-    mesh_at: &MeshAt,
-) -> Option<Suggestion> {
+fn budget_at_size(job: &Job, mesh: &Mesh, can_weld: bool, mesh_at: &MeshAt) -> Option<Suggestion> {
     let edges = mesh.edge_count();
     let area: f64 = mesh.faces().map(|f| mesh.face_area(f)).sum();
     let covering = |edge: f64| area / (AREA_PER_EDGE * (SPREAD_MARGIN * edge).powi(2));
@@ -473,8 +524,13 @@ pub fn clean_budget(
         });
     }
     tries.into_iter().find_map(|repairs| {
-        checked_budget(job, estimate, edges, &|n| mesh_at(n, repairs))
-            .map(|edges| Suggestion { edges, repairs })
+        checked_budget(job, estimate, edges, &|n| mesh_at(job, n, repairs)).map(|edges| {
+            Suggestion {
+                edges,
+                repairs,
+                size: None,
+            }
+        })
     })
 }
 

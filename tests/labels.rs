@@ -69,30 +69,47 @@ struct Survey {
     uneven_panels: usize,
     /// The smallest gap between glyph boxes, in cap heights of the taller label.
     smallest_gap: f64,
+    /// Panels with a label larger than their own id, by name.
+    outgrown_ids: Vec<String>,
 }
 
-/// Builds `model` with `args` through the library's stages up to the fitted labels
-/// and checks every pair of labels on every panel.
+/// The flat panels with their labels fitted: `model` built through the library's
+/// stages at `size`, simplified to `target_edges`. `None` when the scheme cannot build
+/// the model at this size (a crossing larger than the sheet).
+fn fitted(
+    model: &std::path::Path,
+    scheme: &str,
+    size: &str,
+    target_edges: Option<usize>,
+) -> Option<unfold::panel::FlatPanels> {
+    let tmp = TempDir::new().unwrap();
+    let mut o = options(scheme, size, 0, &tmp.path().join("out"));
+    o.holes = None;
+    o.model.target_edges = target_edges.map(unfold::config::TargetEdges::Count);
+    // The woven scheme weaves only a closed mesh.
+    o.model.fill_holes = scheme == "woven";
+    let job = resolve(o, model);
+    let loaded = unfold::run::load(&job).expect("loads");
+    let prepared = unfold::run::prepare(&job, loaded).expect("prepares");
+    let output = unfold::run::scheme(&job, &prepared).ok()?;
+    let flat = unfold::run::flatten(&job, &prepared, &output).expect("flattens");
+    Some(flat.panels)
+}
+
+/// Builds `model` through the library's stages up to the fitted labels and checks
+/// every pair of labels on every panel.
 fn survey(
     model: &std::path::Path,
     scheme: &str,
     size: &str,
     target_edges: Option<usize>,
 ) -> Survey {
-    let tmp = TempDir::new().unwrap();
-    let mut o = options(scheme, size, 0, &tmp.path().join("out"));
-    o.holes = None;
-    o.model.target_edges = target_edges.map(unfold::config::TargetEdges::Count);
-    let job = resolve(o, model);
-    let loaded = unfold::run::load(&job).expect("loads");
-    let prepared = unfold::run::prepare(&job, loaded).expect("prepares");
-    let output = unfold::run::scheme(&job, &prepared).expect("builds");
-    let flat = unfold::run::flatten(&job, &prepared, &output).expect("flattens");
+    let panels = fitted(model, scheme, size, target_edges).expect("builds");
     let mut s = Survey {
         smallest_gap: f64::MAX,
         ..Survey::default()
     };
-    for panel in flat.panels.iter() {
+    for panel in panels.iter() {
         s.panels += 1;
         s.labels += panel.labels.len();
         let boxes: Vec<[DVec2; 4]> = panel.labels.iter().map(glyph_box).collect();
@@ -138,12 +155,30 @@ fn survey(
             hi > lo * (1.0 + 1e-9)
         });
         s.uneven_panels += usize::from(uneven);
+        if outgrows_its_id(panel.labels) {
+            s.outgrown_ids.push(panel.id().to_string());
+        }
     }
     s
 }
 
+/// Whether some label is larger than the panel's own id.
+fn outgrows_its_id(labels: &[FlatLabel]) -> bool {
+    let id = labels
+        .iter()
+        .filter(|l| l.kind == LabelKind::Panel)
+        .map(|l| l.height)
+        .fold(f64::INFINITY, f64::min);
+    labels.iter().any(|l| l.height > id * (1.0 + 1e-9))
+}
+
 fn check(name: &str, s: &Survey, max_uneven_percent: usize) {
     eprintln!("{name}: {s:?}");
+    assert!(
+        s.outgrown_ids.is_empty(),
+        "{name}: panels with a label larger than their own id: {:?}",
+        s.outgrown_ids
+    );
     assert!(s.labels > 2 * s.panels, "{name}: labels were fitted");
     assert!(
         s.unframed_ids * 100 <= s.panels,
@@ -181,4 +216,49 @@ fn labels_of_spot_half_edge_keep_apart_and_its_ids_are_framed() {
     // At 2 m spot's triangles hold their ids (at 4 ft a few hundred are too small).
     let s = survey(&spot, "half-edge", "2m", None);
     check("spot half-edge", &s, 5);
+}
+
+#[test]
+fn no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme() {
+    let Some(shared) =
+        shared_models("no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme")
+    else {
+        return;
+    };
+    let mut models: Vec<_> = std::fs::read_dir(&shared)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj" || x == "off"))
+        .collect();
+    models.sort();
+    // The README's build: 4 ft at the thesis budget of 625 edges; and 2 ft, where the
+    // panels are small and the labels compete for room.
+    let mut surveyed = 0;
+    for model in &models {
+        for scheme in ["half-edge", "quad-edge", "winged-edge", "woven", "net"] {
+            for size in ["2ft", "4ft"] {
+                let name = format!("{} {scheme} {size}", model.display());
+                let Some(panels) = fitted(model, scheme, size, Some(625)) else {
+                    eprintln!("{name}: not built (larger than the sheet)");
+                    continue;
+                };
+                surveyed += 1;
+                let outgrown: Vec<String> = panels
+                    .iter()
+                    .filter(|p| outgrows_its_id(p.labels))
+                    .map(|p| p.id().to_string())
+                    .collect();
+                eprintln!("{name}: {} panels", panels.len());
+                assert!(
+                    outgrown.is_empty(),
+                    "{name}: panels with a label larger than their own id: {outgrown:?}"
+                );
+            }
+        }
+    }
+    // Only the cube's woven ribbons are larger than the sheet.
+    assert!(
+        surveyed + 2 >= 10 * models.len(),
+        "{surveyed} builds surveyed"
+    );
 }

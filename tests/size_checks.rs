@@ -646,6 +646,48 @@ fn the_teapots_open_seams_are_joined_shut_and_auto_weaves_it() {
 }
 
 #[test]
+fn where_no_budget_builds_at_the_size_asked_a_larger_size_is_named_with_its_budget() {
+    let Some(shared) = shared_models(
+        "where_no_budget_builds_at_the_size_asked_a_larger_size_is_named_with_its_budget",
+    ) else {
+        return;
+    };
+    // fertility's winged-edge panels at 2 ft: at the fewest edges its genus allows
+    // some faces are too thin for a hole, above that too small for their ids.
+    let fertility = shared.join("fertility.obj");
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let args = [
+        "--scheme",
+        "winged-edge",
+        "--size",
+        "2ft",
+        "--nester",
+        "shelf",
+    ];
+    let run = build(&fertility, &out, &args);
+    assert_refused(
+        "fertility",
+        &run,
+        &out,
+        &[
+            "try --size 1.22m --target-edges ",
+            "(at the size asked, no budget gives every panel its id and holes)",
+            "(or --size 1.22m --target-edges auto)",
+        ],
+    );
+    assert_named_fix_builds_clean(&fertility, &out, &args, &run, &["--size", "1.22m"]);
+    let auto = [
+        &args[..],
+        &["--size", "1.22m", "--target-edges", "auto", "--force"],
+    ]
+    .concat();
+    let run = build(&fertility, &out, &auto);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    assert!(!run.stderr.contains("warning:"), "{}", run.stderr);
+}
+
+#[test]
 fn auto_shows_only_the_warnings_of_the_build_it_keeps() {
     let Some(shared) = shared_models("auto_shows_only_the_warnings_of_the_build_it_keeps") else {
         return;

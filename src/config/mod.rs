@@ -176,9 +176,9 @@ pub struct ModelOptions {
     #[arg(long, value_name = "N")]
     pub min_component: Option<usize>,
 
-    /// Close every hole of the mesh with one face along its rim (a scan's open base, a
-    /// patch model's open rims): short rim edges no longer limit simplification, and
-    /// the woven scheme can weave the model.
+    /// Close every hole of the mesh with a face along its rim (a scan's open base, a
+    /// patch model's open rims), joining open seams shut: short rim edges no longer
+    /// limit simplification, and the woven scheme can weave the model.
     #[arg(long)]
     #[serde(default)]
     pub fill_holes: bool,
@@ -313,7 +313,7 @@ pub struct ModelSettings {
     pub simplify_mode: crate::mesh::simplify::SimplifyMode,
     /// Components with fewer faces than this are removed (0 keeps all).
     pub min_component: usize,
-    /// Close every boundary loop with one face.
+    /// Close every boundary loop (a face along its rim; open seams joined shut).
     pub fill_holes: bool,
 }
 

@@ -974,6 +974,35 @@ fn plan_segments(ribbon: &Ribbon, limits: &Limits) -> Result<Vec<(usize, usize)>
     Ok(best)
 }
 
+/// The error for a ribbon whose crossing after `corner` cannot be cut as a segment:
+/// one over a face of almost no area, or one larger than the sheet.
+fn crossing_error(r: &Ribbon, corner: usize) -> SchemeError {
+    // The crossing: this corner's pieces and the next corner's face pieces.
+    let ring = r.lines.len();
+    let pieces = r.corner_pieces(corner).len() + face_part(r, corner + 1).len();
+    let start = r.corner_start[corner];
+    let points: Vec<DVec3> = (start..=start + pieces)
+        .flat_map(|l| r.lines[l % ring])
+        .collect();
+    let across = crate::mesh::geometry::diameter(&points);
+    let flat_facet = (start..start + pieces).any(|k| {
+        let k = k % ring;
+        r.facets[k].iter().any(|facet| {
+            let corners = facet.iter().map(|&c| r.point(k, c));
+            vector_area(corners).length() <= DEGENERATE_AREA * across * across
+        })
+    });
+    let why = if flat_facet {
+        "crosses a face of almost no area (three corners in a line), which cannot be unrolled; simplify the model (--target-edges) or mend that face"
+    } else {
+        "does not fit the sheet; use a larger --sheet or a smaller --size"
+    };
+    SchemeError::Model(format!(
+        "cycle {}: one edge crossing of its ribbon is {across:.1} mm across and {why}",
+        cycle_id(r.cycle),
+    ))
+}
+
 /// Builds the woven panels: one per segment of every cycle's ribbon.
 pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, SchemeError> {
     let (ribbons, ribbon_notes) = ribbons(mesh, options)?;
@@ -983,35 +1012,7 @@ pub fn panels(mesh: &Mesh, options: &WovenOptions) -> Result<SchemeOutput, Schem
     };
     let plans: Vec<Vec<(usize, usize)>> = ribbons
         .par_iter()
-        .map(|r| {
-            plan_segments(r, &limits).map_err(|corner| {
-                // The crossing that does not fit: this corner's pieces and the next
-                // corner's face pieces.
-                let ring = r.lines.len();
-                let pieces = r.corner_pieces(corner).len() + face_part(r, corner + 1).len();
-                let start = r.corner_start[corner];
-                let points: Vec<DVec3> = (start..=start + pieces)
-                    .flat_map(|l| r.lines[l % ring])
-                    .collect();
-                let across = crate::mesh::geometry::diameter(&points);
-                let flat_facet = (start..start + pieces).any(|k| {
-                    let k = k % ring;
-                    r.facets[k].iter().any(|facet| {
-                        let corners = facet.iter().map(|&c| r.point(k, c));
-                        vector_area(corners).length() <= DEGENERATE_AREA * across * across
-                    })
-                });
-                let why = if flat_facet {
-                    "crosses a face of almost no area (three corners in a line), which cannot be unrolled; simplify the model (--target-edges) or mend that face"
-                } else {
-                    "does not fit the sheet; use a larger --sheet or a smaller --size"
-                };
-                SchemeError::Model(format!(
-                    "cycle {}: one edge crossing of its ribbon is {across:.1} mm across and {why}",
-                    cycle_id(r.cycle),
-                ))
-            })
-        })
+        .map(|r| plan_segments(r, &limits).map_err(|corner| crossing_error(r, corner)))
         .collect::<Vec<_>>()
         // Collected in cycle order first, so that the error names the first cycle
         // that fails whatever the thread count.
