@@ -163,3 +163,229 @@ fn no_map_writes_none() {
         manifest["files"]
     );
 }
+
+/// A text of the map: its box on the page (mm) and its words.
+#[derive(Debug)]
+struct TextBox {
+    lo: glam::DVec2,
+    hi: glam::DVec2,
+    text: String,
+    /// A panel id written in a view (centred), not page furniture.
+    id: bool,
+}
+
+/// Every `<text>` of the map with its box, measured with Arial's advance widths as the
+/// map measures them: from the baseline up a cap height and down a descender.
+fn text_boxes(svg: &str) -> Vec<TextBox> {
+    use common::map::attribute;
+    svg.split("<text")
+        .skip(1)
+        .map(|chunk| {
+            let tag = &chunk[..chunk.find('>').unwrap()];
+            let text = chunk[tag.len() + 1..chunk.find("</text>").unwrap()]
+                .replace("&lt;", "<")
+                .replace("&gt;", ">")
+                .replace("&quot;", "\"")
+                .replace("&amp;", "&");
+            let x: f64 = attribute(tag, "x").parse().unwrap();
+            let y: f64 = attribute(tag, "y").parse().unwrap();
+            let size: f64 = attribute(tag, "font-size").parse().unwrap();
+            let width = unfold::export::map_page::text_width(&text, size);
+            let id = tag.contains("text-anchor=\"middle\"");
+            // Ids are centred, their baseline 0.35 em below their point.
+            let (left, baseline) = if id {
+                (x - 0.5 * width, y + 0.35 * size)
+            } else {
+                (x, y)
+            };
+            TextBox {
+                lo: glam::DVec2::new(left, baseline - 0.75 * size),
+                hi: glam::DVec2::new(left + width, baseline + 0.2 * size),
+                text,
+                id,
+            }
+        })
+        .collect()
+}
+
+fn overlap(a: (glam::DVec2, glam::DVec2), b: (glam::DVec2, glam::DVec2)) -> bool {
+    a.0.x < b.1.x && b.0.x < a.1.x && a.0.y < b.1.y && b.0.y < a.1.y
+}
+
+/// CIELAB (D65) of an `#RRGGBB` colour.
+fn lab(hex: &str) -> [f64; 3] {
+    let channel = |i: usize| {
+        let c = u8::from_str_radix(&hex[1 + 2 * i..3 + 2 * i], 16).unwrap() as f64 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let (r, g, b) = (channel(0), channel(1), channel(2));
+    let x = (0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047;
+    let y = 0.2126 * r + 0.7152 * g + 0.0722 * b;
+    let z = (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883;
+    let f = |t: f64| {
+        if t > 216.0 / 24389.0 {
+            t.cbrt()
+        } else {
+            (24389.0 / 27.0 * t + 16.0) / 116.0
+        }
+    };
+    [
+        116.0 * f(y) - 16.0,
+        500.0 * (f(x) - f(y)),
+        200.0 * (f(y) - f(z)),
+    ]
+}
+
+/// Least CIE76 colour difference between any two sheets' tints on the map: well
+/// beyond the 2.3 at which two colours side by side are told apart at all.
+const TINT_DIFFERENCE: f64 = 12.0;
+
+/// Checks a map page of `width` x `height` mm for `sheets` sheets: every text inside
+/// the page, no two text boxes overlapping, every view's drawing clear of the other
+/// views and of the page's text, a swatch and its number for every sheet, and tints
+/// that differ by at least [`TINT_DIFFERENCE`].
+fn check_page(case: &str, svg: &str, width: f64, height: f64, sheets: usize) {
+    let texts = text_boxes(svg);
+    for t in &texts {
+        assert!(
+            t.lo.x >= 0.0 && t.lo.y >= 0.0 && t.hi.x <= width && t.hi.y <= height,
+            "{case}: {:?} leaves the page",
+            t
+        );
+    }
+    for (i, a) in texts.iter().enumerate() {
+        for b in &texts[i + 1..] {
+            assert!(
+                !overlap((a.lo, a.hi), (b.lo, b.hi)),
+                "{case}: {:?} and {:?} overlap",
+                a.text,
+                b.text
+            );
+        }
+    }
+    // Each view's drawing (its patches' corners), against the others and the page's
+    // text (its caption included).
+    let drawings: Vec<(glam::DVec2, glam::DVec2)> = svg
+        .split("<g id=\"view-")
+        .skip(1)
+        .map(|chunk| {
+            let body = &chunk[..chunk.find("</g>").unwrap()];
+            let mut lo = glam::DVec2::splat(f64::INFINITY);
+            let mut hi = -lo;
+            for path in body.split("<path d=\"").skip(1) {
+                let d = &path[..path.find('"').unwrap()];
+                let n: Vec<f64> = d
+                    .split(|c: char| c == ' ' || c.is_ascii_alphabetic())
+                    .filter(|s| !s.is_empty())
+                    .map(|s| s.parse().unwrap())
+                    .collect();
+                for p in n.chunks(2) {
+                    lo = lo.min(glam::DVec2::new(p[0], p[1]));
+                    hi = hi.max(glam::DVec2::new(p[0], p[1]));
+                }
+            }
+            (lo, hi)
+        })
+        .collect();
+    assert_eq!(drawings.len(), 6, "{case}");
+    for (i, &a) in drawings.iter().enumerate() {
+        assert!(
+            a.0.x >= 0.0 && a.0.y >= 0.0 && a.1.x <= width && a.1.y <= height,
+            "{case}: view {i} leaves the page"
+        );
+        for &b in &drawings[i + 1..] {
+            assert!(!overlap(a, b), "{case}: two views overlap");
+        }
+        for t in texts.iter().filter(|t| !t.id) {
+            assert!(
+                !overlap(a, (t.lo, t.hi)),
+                "{case}: view {i} runs into {:?}",
+                t.text
+            );
+        }
+    }
+    // The legend: every sheet's swatch and number.
+    let legend = &svg[svg.find("<g id=\"legend\">").expect("a legend")..];
+    let swatches: Vec<&str> = legend
+        .split("<rect ")
+        .skip(1)
+        .map(|r| {
+            let at = r.find("fill=\"").unwrap() + 6;
+            &r[at..at + 7]
+        })
+        .collect();
+    assert_eq!(swatches.len(), sheets, "{case}: swatches");
+    let numbers: Vec<String> = texts
+        .iter()
+        .filter(|t| t.text.chars().all(|c| c.is_ascii_digit()))
+        .map(|t| t.text.clone())
+        .collect();
+    for sheet in 1..=sheets {
+        assert!(
+            numbers.contains(&sheet.to_string()),
+            "{case}: sheet {sheet}"
+        );
+    }
+    for (i, a) in swatches.iter().enumerate() {
+        for b in &swatches[i + 1..] {
+            let (p, q) = (lab(a), lab(b));
+            let d = ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt();
+            assert!(
+                d >= TINT_DIFFERENCE,
+                "{case}: tints {a} and {b} differ by {d:.1}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_map_fits_every_paper_for_any_number_of_sheets() {
+    let tmp = TempDir::new().unwrap();
+    let mut o = options("quad-edge", "300mm", 0, &tmp.path().join("out"));
+    o.holes = None;
+    let p = common::build::pipeline(&resolve(o, &model("torus-8x6")));
+    let surface =
+        unfold::panel::surface::panel_surface(&p.mesh, &p.output.panels, &p.output.face_groups);
+    let parts = p.output.panels.len();
+    for paper in ["A5", "A4", "A3", "letter", "18x24in"] {
+        let size = unfold::config::parse_sheet(paper).unwrap();
+        for sheets in [1, 3, 12, 40] {
+            // The panels dealt out over the sheets: the map reads only their sheet.
+            let layout = unfold::nest::Layout {
+                sheet: unfold::nest::SheetSpec {
+                    width: size.width,
+                    height: size.height,
+                    margin: 5.0,
+                    spacing: 2.0,
+                },
+                sheets,
+                placements: (0..parts)
+                    .map(|part| unfold::nest::Placement {
+                        part,
+                        sheet: part % sheets,
+                        rotation: 0.0,
+                        translation: glam::DVec2::ZERO,
+                        mirrored: false,
+                    })
+                    .collect(),
+            };
+            let svg = unfold::export::map::assembly_map(&unfold::export::map::MapInput {
+                surface: &surface,
+                panels: &p.output.panels,
+                layout: &layout,
+                name: "torus-8x6-as-downloaded-from-a-public-collection",
+            });
+            check_page(
+                &format!("{paper}, {sheets} sheets"),
+                &svg,
+                size.width,
+                size.height,
+                sheets,
+            );
+        }
+    }
+}

@@ -343,6 +343,21 @@ fn a_panel_larger_than_the_sheet_is_a_usage_error() {
             "use a larger --sheet or a smaller --size",
         ],
     );
+    // A woven ribbon whose every crossing is larger than the sheet: the same.
+    let run = build(
+        &model("hexahedron"),
+        &out,
+        &["--scheme", "woven", "--size", "400mm", "--sheet", "A5"],
+    );
+    assert_refused(
+        "400 mm cube woven on A5",
+        &run,
+        &out,
+        &[
+            "one edge crossing of its ribbon is ",
+            " mm across and does not fit the sheet; use a larger --sheet or a smaller --size",
+        ],
+    );
 }
 
 /// A flat model (every vertex on one plane) is named as such: its panels would lie

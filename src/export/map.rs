@@ -15,6 +15,7 @@ use std::fmt::Write;
 use glam::{DVec2, DVec3};
 
 use super::fmt_mm;
+use super::map_page::{fit, text_width, Lines, Palette, LINE};
 use crate::nest::Layout;
 use crate::panel::surface::{PanelSurface, Patch};
 use crate::panel::{IdKind, Panels};
@@ -93,17 +94,20 @@ const RASTER_PER_MM: f64 = 4.0;
 const TEXT_MIN: f64 = 1.8;
 const TEXT_MAX: f64 = 3.0;
 
-/// Width of an id's text per character, in text heights (sans-serif digits and
-/// capitals), for the collision test.
-const CHAR_WIDTH: f64 = 0.62;
-
-/// Page furniture (mm): the outer border, the title's line, the legend's line, and
-/// the strip at the top of each view's cell for its caption (the drawing keeps as much
-/// free below it).
+/// The page's outer border (mm).
 const BORDER: f64 = 8.0;
-const TITLE: f64 = 10.0;
-const LEGEND: f64 = 16.0;
-const CAPTION: f64 = 3.0;
+
+/// Text heights (mm) of the page furniture: the largest each is set at, and the
+/// smallest it shrinks to before it wraps onto more lines.
+const TITLE_TEXT: [f64; 2] = [6.0, 3.0];
+const CAPTION_TEXT: [f64; 2] = [4.5, 2.2];
+const LEGEND_TEXT: [f64; 2] = [3.5, 2.5];
+
+/// A legend row of sheet swatches (mm).
+const SWATCH_ROW: f64 = 5.5;
+
+/// Space (mm) below a block of text before what follows it.
+const GAP: f64 = 1.5;
 
 /// What the map is drawn from.
 pub struct MapInput<'a> {
@@ -134,30 +138,116 @@ pub fn assembly_map(input: &MapInput) -> String {
         .iter()
         .map(|v| bounds(patches.iter().flat_map(|p| &p.points), v))
         .collect();
-    let grid = Grid::largest(input, &extents);
+    let page = Page::new(input);
+    let grid = Grid::largest(&page, &views, &extents);
     let map = MapContext {
         input,
         sheet_of,
         panel_patches,
         text: text_height(input, grid.scale),
+        palette: Palette::new(input.layout.sheets),
         grid,
     };
 
     let mut out = String::new();
-    page_head(&mut out, input);
+    page_head(&mut out, &page);
     let mut named = vec![false; input.panels.len()];
     for (k, view) in views.iter().enumerate() {
         draw_view(&mut out, &map, k, view, extents[k], &mut named);
     }
-    let (_, page_h) = page_size(input);
-    legend(
-        &mut out,
-        input,
-        page_h,
-        named.iter().filter(|&&n| n).count(),
-    );
+    legend(&mut out, &map, &page, named.iter().filter(|&&n| n).count());
     out.push_str("</svg>\n");
     out
+}
+
+/// The page and its furniture, measured: the title at the top, the legend at the foot
+/// (swatch rows and the id key), and the area between them for the views.
+struct Page {
+    width: f64,
+    height: f64,
+    title: Lines,
+    /// Sheet swatches per legend row, and rows.
+    swatches_per_row: usize,
+    swatch_rows: usize,
+    /// The id key's text size and the most lines it may take.
+    key: Lines,
+}
+
+impl Page {
+    fn new(input: &MapInput) -> Page {
+        let (width, height) = page_size(input);
+        let text_w = width - 2.0 * BORDER;
+        let title = fit(&title_text(input), text_w, TITLE_TEXT[0], TITLE_TEXT[1], 2);
+        let sheets = input.layout.sheets.max(1);
+        let entry = swatch_width(sheets);
+        let room = text_w - text_width(SHEETS_WORD, LEGEND_TEXT[0]);
+        let swatches_per_row = ((room / entry).floor() as usize).max(1);
+        // The key as long as it can be: every panel named.
+        let key = fit(
+            &key_text(input.panels, input.panels.len()),
+            text_w,
+            LEGEND_TEXT[0],
+            LEGEND_TEXT[1],
+            3,
+        );
+        Page {
+            width,
+            height,
+            title,
+            swatches_per_row,
+            swatch_rows: sheets.div_ceil(swatches_per_row),
+            key,
+        }
+    }
+
+    /// The height of the title's block (mm).
+    fn title_height(&self) -> f64 {
+        self.title.height() + GAP
+    }
+
+    /// The height of the legend's block (mm).
+    fn legend_height(&self) -> f64 {
+        self.swatch_rows as f64 * SWATCH_ROW + GAP + self.key.height()
+    }
+
+    /// Where the views go: the top-left corner and size (mm).
+    fn views_area(&self) -> (DVec2, DVec2) {
+        let lo = DVec2::new(BORDER, BORDER + self.title_height());
+        let size = DVec2::new(
+            self.width - 2.0 * BORDER,
+            self.height - 2.0 * BORDER - self.title_height() - self.legend_height(),
+        );
+        (lo, size.max(DVec2::splat(1.0)))
+    }
+}
+
+/// The legend's word before the sheet swatches.
+const SHEETS_WORD: &str = "Sheets: ";
+
+/// The width (mm) of one sheet's swatch and number in the legend, for `sheets` sheets.
+fn swatch_width(sheets: usize) -> f64 {
+    4.0 + 1.0 + text_width(&sheets.to_string(), LEGEND_TEXT[0]) + 3.0
+}
+
+/// The map's title.
+fn title_text(input: &MapInput) -> String {
+    format!(
+        "{}: assembly map, {} on {} (tint: sheet; text: panel id)",
+        input.name,
+        crate::units::count_of(input.panels.len(), "panel"),
+        crate::units::count_of(input.layout.sheets, "sheet")
+    )
+}
+
+/// A view's caption.
+fn caption_text(view: &View) -> String {
+    format!(
+        "{} (from {}, turned {:.0}° toward {})",
+        view.name,
+        view.axis,
+        TILT.atan().to_degrees(),
+        view.turn
+    )
 }
 
 /// What every view of a map is drawn with.
@@ -170,6 +260,8 @@ struct MapContext<'a> {
     grid: Grid,
     /// The ids' text height (mm).
     text: f64,
+    /// The sheets' tints.
+    palette: Palette,
 }
 
 /// The page's grid of views and the one scale they share.
@@ -177,42 +269,59 @@ struct Grid {
     cols: usize,
     /// Page mm per model mm.
     scale: f64,
+    /// The top-left corner of the views' area.
+    lo: DVec2,
     cell_w: f64,
     cell_h: f64,
+    /// Each view's caption, fitted to the cell's width, and the caption strip's height.
+    captions: Vec<Lines>,
+    caption_h: f64,
 }
 
 impl Grid {
     /// The grid of views (columns x rows) that draws the model largest, one scale for
-    /// all views so they compare.
-    fn largest(input: &MapInput, extents: &[(DVec2, DVec2)]) -> Grid {
-        let (page_w, page_h) = page_size(input);
-        let area_w = page_w - 2.0 * BORDER;
-        let area_h = page_h - 2.0 * BORDER - TITLE - LEGEND;
-        let (cols, rows, scale) = [(2usize, 3usize), (3, 2), (1, 6), (6, 1)]
+    /// all views so they compare, each view's caption fitted to its cell.
+    fn largest(page: &Page, views: &[View], extents: &[(DVec2, DVec2)]) -> Grid {
+        let (lo, area) = page.views_area();
+        [(2usize, 3usize), (3, 2), (1, 6), (6, 1)]
             .into_iter()
-            .map(|(c, r)| {
-                let (cw, ch) = (area_w / c as f64, area_h / r as f64 - 2.0 * CAPTION);
-                let s = extents
+            .map(|(cols, rows)| {
+                let (cell_w, cell_h) = (area.x / cols as f64, area.y / rows as f64);
+                let captions: Vec<Lines> = views
+                    .iter()
+                    .map(|v| {
+                        let [largest, smallest] = CAPTION_TEXT;
+                        fit(&caption_text(v), cell_w - 4.0, largest, smallest, 2)
+                    })
+                    .collect();
+                let caption_h = captions.iter().map(Lines::height).fold(0.0, f64::max) + GAP;
+                let draw_h = (cell_h - caption_h - GAP).max(1e-3);
+                let scale = extents
                     .iter()
                     .map(|(lo, hi)| {
                         let size = (*hi - *lo).max(DVec2::splat(1e-9));
-                        (0.92 * cw / size.x).min(0.92 * ch / size.y)
+                        (0.92 * cell_w / size.x).min(0.92 * draw_h / size.y)
                     })
                     .fold(f64::INFINITY, f64::min);
-                (c, r, s)
+                Grid {
+                    cols,
+                    scale: if scale.is_finite() && scale > 0.0 {
+                        scale
+                    } else {
+                        1.0
+                    },
+                    lo,
+                    cell_w,
+                    cell_h,
+                    captions,
+                    caption_h,
+                }
             })
-            .max_by(|a, b| a.2.total_cmp(&b.2))
-            .unwrap_or((2, 3, 1.0));
-        Grid {
-            cols,
-            scale: if scale.is_finite() && scale > 0.0 {
-                scale
-            } else {
-                1.0
-            },
-            cell_w: area_w / cols as f64,
-            cell_h: area_h / rows as f64,
-        }
+            .fold(None, |best: Option<Grid>, grid| match best {
+                Some(b) if b.scale >= grid.scale => Some(b),
+                _ => Some(grid),
+            })
+            .expect("four grids are tried")
     }
 }
 
@@ -222,8 +331,8 @@ fn page_size(input: &MapInput) -> (f64, f64) {
 }
 
 /// The SVG header, the white page and the title.
-fn page_head(out: &mut String, input: &MapInput) {
-    let (page_w, page_h) = page_size(input);
+fn page_head(out: &mut String, page: &Page) {
+    let (page_w, page_h) = (page.width, page.height);
     let _ = writeln!(
         out,
         "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{w}mm\" height=\"{h}mm\" viewBox=\"0 0 {w} {h}\" font-family=\"Helvetica, Arial, sans-serif\">",
@@ -236,15 +345,23 @@ fn page_head(out: &mut String, input: &MapInput) {
         fmt_mm(page_w),
         fmt_mm(page_h)
     );
-    let _ = writeln!(
-        out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"6\">{}: assembly map, {} panels on {} sheets (tint: sheet; text: panel id)</text>",
-        fmt_mm(BORDER),
-        fmt_mm(BORDER + 6.0),
-        escape(input.name),
-        input.panels.len(),
-        input.layout.sheets
-    );
+    text_lines(out, &page.title, DVec2::new(BORDER, BORDER));
+}
+
+/// Writes `lines` left-aligned, the first line's top at `top_left`.
+fn text_lines(out: &mut String, lines: &Lines, top_left: DVec2) {
+    for (i, line) in lines.lines.iter().enumerate() {
+        // A line's baseline sits a cap height and a little below its top.
+        let baseline = top_left.y + (i as f64 * LINE + 1.0) * lines.size;
+        let _ = writeln!(
+            out,
+            "<text x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>",
+            fmt_mm(top_left.x),
+            fmt_mm(baseline),
+            fmt_mm(lines.size),
+            escape(line)
+        );
+    }
 }
 
 /// View `k` in its cell: its group (with the projection, for readers that map page
@@ -260,14 +377,13 @@ fn draw_view(
 ) {
     let grid = &map.grid;
     let (col, row) = (k % grid.cols, k / grid.cols);
-    let cell_lo = DVec2::new(
-        BORDER + col as f64 * grid.cell_w,
-        BORDER + TITLE + row as f64 * grid.cell_h,
-    );
+    let cell_lo = grid.lo + DVec2::new(col as f64 * grid.cell_w, row as f64 * grid.cell_h);
     let centre = 0.5 * (lo + hi);
-    // Page point of a model point: the view's (right, up) scaled, y down.
+    // Page point of a model point: the view's (right, up) scaled, y down, centred in
+    // the cell below its caption.
     let scale = grid.scale;
-    let origin = cell_lo + DVec2::new(0.5 * grid.cell_w, 0.5 * (grid.cell_h + CAPTION))
+    let drawing_mid = grid.caption_h + 0.5 * (grid.cell_h - grid.caption_h - GAP);
+    let origin = cell_lo + DVec2::new(0.5 * grid.cell_w, drawing_mid)
         - scale * DVec2::new(centre.x, -centre.y);
     let to_page = |p: DVec3| {
         let q = project(p, view);
@@ -283,16 +399,7 @@ fn draw_view(
         origin.y,
         name = view.name
     );
-    let _ = writeln!(
-        out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"4.5\">{} (from {}, turned {:.0}° toward {})</text>",
-        fmt_mm(cell_lo.x + 2.0),
-        fmt_mm(cell_lo.y + 5.0),
-        view.name,
-        view.axis,
-        TILT.atan().to_degrees(),
-        view.turn
-    );
+    text_lines(out, &grid.captions[k], cell_lo + DVec2::new(2.0, 0.0));
     let order = far_to_near(map.input.surface, view);
     draw_patches(out, map, &order, view, &to_page);
     let raster = Raster::new(cell_lo, DVec2::new(grid.cell_w, grid.cell_h));
@@ -336,7 +443,7 @@ fn draw_patches(
     for &(_, i) in order {
         let patch = &map.input.surface.patches[i];
         let facing = patch.normal.dot(view.toward);
-        let fill = sheet_colour(map.sheet_of[patch.panel], facing);
+        let fill = map.palette.colour(map.sheet_of[patch.panel], facing);
         let mut d = String::new();
         for (j, &p) in patch.points.iter().enumerate() {
             let q = to_page(p);
@@ -376,7 +483,7 @@ fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mu
     let mut placed = Placed::new(text * 4.0);
     for p in candidates {
         let id = panels.get(p).id().to_string();
-        let half = 0.5 * DVec2::new(CHAR_WIDTH * text * id.len() as f64, text);
+        let half = 0.5 * DVec2::new(text_width(&id, text), text);
         // The anchor, or where it is crowded, a point nearer the middle of one of
         // the panel's patches: always on the panel itself as seen.
         let spot = spots(map.input.surface.anchors[p], &map.panel_patches[p], patches)
@@ -459,62 +566,58 @@ fn text_height(input: &MapInput, scale: f64) -> f64 {
     (0.2 * sizes[sizes.len() / 2] * scale).clamp(TEXT_MIN, TEXT_MAX)
 }
 
-/// The tint of a sheet: hues spread by the golden angle (neighbouring sheet numbers
-/// look different), light enough for black text, shaded by how squarely the patch
-/// faces the viewer.
-fn sheet_colour(sheet: usize, facing: f64) -> String {
-    let hue = (sheet as f64 * 137.508) % 360.0;
-    let light = 0.62 + 0.2 * facing.abs().clamp(0.0, 1.0);
-    let rgb = hsl(hue, 0.55, light);
-    format!("#{:02X}{:02X}{:02X}", rgb[0], rgb[1], rgb[2])
-}
-
-fn hsl(hue: f64, s: f64, l: f64) -> [u8; 3] {
-    let c = (1.0 - (2.0 * l - 1.0).abs()) * s;
-    let h = hue / 60.0;
-    let x = c * (1.0 - (h % 2.0 - 1.0).abs());
-    let (r, g, b) = match h as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = l - 0.5 * c;
-    [r, g, b].map(|v| ((v + m) * 255.0).round().clamp(0.0, 255.0) as u8)
-}
-
-/// The sheets' tints and the id letters, along the page's foot.
-fn legend(out: &mut String, input: &MapInput, page_h: f64, named: usize) {
-    let y = page_h - BORDER - LEGEND;
-    let mut x = BORDER;
+/// The sheets' tints (rows of numbered swatches) and the id key, along the page's
+/// foot.
+fn legend(out: &mut String, map: &MapContext, page: &Page, named: usize) {
+    let input = map.input;
+    let top = page.height - BORDER - page.legend_height();
     let _ = writeln!(out, "<g id=\"legend\">");
-    for sheet in 0..input.layout.sheets {
-        let _ = writeln!(
-            out,
-            "<rect x=\"{}\" y=\"{}\" width=\"4\" height=\"4\" fill=\"{}\" stroke=\"#606060\" stroke-width=\"0.1\"/><text x=\"{}\" y=\"{}\" font-size=\"3.5\">sheet {}</text>",
-            fmt_mm(x),
-            fmt_mm(y),
-            sheet_colour(sheet, 1.0),
-            fmt_mm(x + 5.0),
-            fmt_mm(y + 3.5),
-            sheet + 1
-        );
-        x += 24.0;
-        if x > input.layout.sheet.width - BORDER - 24.0 {
-            break;
-        }
-    }
+    let size = LEGEND_TEXT[0];
     let _ = writeln!(
         out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"3.5\">Ids: {}. {named} of {} panels named; one crowded out of a view is named in another.</text>",
+        "<text x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>",
         fmt_mm(BORDER),
-        fmt_mm(y + 11.0),
-        escape(&id_legend(input.panels)),
-        input.panels.len()
+        fmt_mm(top + 3.5),
+        fmt_mm(size),
+        SHEETS_WORD.trim_end()
     );
+    let entry = swatch_width(input.layout.sheets.max(1));
+    let first_x = BORDER + text_width(SHEETS_WORD, size);
+    for sheet in 0..input.layout.sheets {
+        let (row, col) = (sheet / page.swatches_per_row, sheet % page.swatches_per_row);
+        let (x, y) = (first_x + col as f64 * entry, top + row as f64 * SWATCH_ROW);
+        let _ = writeln!(
+            out,
+            "<rect x=\"{}\" y=\"{}\" width=\"4\" height=\"4\" fill=\"{}\" stroke=\"#606060\" stroke-width=\"0.1\"/><text x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>",
+            fmt_mm(x),
+            fmt_mm(y),
+            map.palette.colour(sheet, 1.0),
+            fmt_mm(x + 5.0),
+            fmt_mm(y + 3.5),
+            fmt_mm(size),
+            sheet + 1
+        );
+    }
+    // The key at the size the page was laid out for (the text is never longer).
+    let key = fit(
+        &key_text(input.panels, named),
+        page.width - 2.0 * BORDER,
+        page.key.size,
+        page.key.size,
+        1,
+    );
+    let key_top = top + page.swatch_rows as f64 * SWATCH_ROW + GAP;
+    text_lines(out, &key, DVec2::new(BORDER, key_top));
     out.push_str("</g>\n");
+}
+
+/// The legend's key: what the ids mean and how many panels are named.
+fn key_text(panels: &Panels, named: usize) -> String {
+    format!(
+        "Ids: {}. {named} of {} panels named; one crowded out of a view is named in another.",
+        id_legend(panels),
+        panels.len()
+    )
 }
 
 /// What each kind of id on the panels means, in the schemes' own words: the panels'

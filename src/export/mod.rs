@@ -8,6 +8,7 @@ pub mod folder;
 pub mod laser;
 pub mod manifest;
 pub mod map;
+pub mod map_page;
 pub mod obj;
 pub mod report;
 pub mod svg;

@@ -992,15 +992,18 @@ fn crossing_error(r: &Ribbon, corner: usize) -> SchemeError {
             vector_area(corners).length() <= DEGENERATE_AREA * across * across
         })
     });
-    let why = if flat_facet {
-        "crosses a face of almost no area (three corners in a line), which cannot be unrolled; simplify the model (--target-edges) or mend that face"
+    let cycle = cycle_id(r.cycle);
+    if flat_facet {
+        SchemeError::Model(format!(
+            "cycle {cycle}: one edge crossing of its ribbon crosses a face of almost no area (three corners in a line), which cannot be unrolled; simplify the model (--target-edges) or mend that face"
+        ))
     } else {
-        "does not fit the sheet; use a larger --sheet or a smaller --size"
-    };
-    SchemeError::Model(format!(
-        "cycle {}: one edge crossing of its ribbon is {across:.1} mm across and {why}",
-        cycle_id(r.cycle),
-    ))
+        // Like a panel larger than the sheet: the size and the sheet asked for are
+        // what does not go together (exit 2).
+        SchemeError::Options(format!(
+            "cycle {cycle}: one edge crossing of its ribbon is {across:.1} mm across and does not fit the sheet; use a larger --sheet or a smaller --size"
+        ))
+    }
 }
 
 /// Builds the woven panels: one per segment of every cycle's ribbon.
