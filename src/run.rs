@@ -571,21 +571,27 @@ pub fn export(
         format!("{name}-assembled.obj"),
         assembled_obj(&output.panels).into_bytes(),
     ));
-    if job.map {
+    let map = job.map.then(|| {
         let surface = crate::panel::surface::panel_surface(
             &prepared.scheme_mesh.mesh,
             &output.panels,
             &output.face_groups,
         );
-        let map = crate::export::map::assembly_map(&crate::export::map::MapInput {
+        crate::export::map::assembly_map(&crate::export::map::MapInput {
             surface: &surface,
             panels: &output.panels,
             layout,
             name: &name,
-        });
-        files.push((format!("{name}-map.svg"), map.into_bytes()));
+        })
+    });
+    if let Some(map) = &map {
+        files.push((format!("{name}-map.svg"), map.clone().into_bytes()));
     }
     manifest.warnings = warnings;
+    if job.preview {
+        let page = preview(job, layout, panels, &name, &manifest, map.as_deref());
+        files.push((format!("{name}.html"), page.into_bytes()));
+    }
     manifest.files = files
         .iter()
         .map(|(n, _)| n.clone())
@@ -595,6 +601,36 @@ pub fn export(
         .map_err(|e| Error::internal("writing the manifest", e))?;
     files.push((MANIFEST.into(), (json + "\n").into_bytes()));
     Ok(Exported { files, manifest })
+}
+
+/// The preview page ([`crate::export::preview`]): every sheet drawn again with strokes
+/// wide enough to see, beside the map and the manifest's figures.
+fn preview(
+    job: &Job,
+    layout: &Layout,
+    panels: &FlatPanels,
+    name: &str,
+    manifest: &Manifest,
+    map: Option<&str>,
+) -> String {
+    let mut style = job.style.clone();
+    let stroke = crate::export::preview::preview_stroke(layout.sheet.width);
+    for layer in style.layers.0.iter_mut() {
+        layer.stroke_width = layer.stroke_width.max(stroke);
+    }
+    let sheets: Vec<String> = (0..layout.sheets)
+        .into_par_iter()
+        .map(|index| {
+            let svg = crate::export::Format::Svg.write_sheet(layout, index, panels, &style);
+            String::from_utf8_lossy(&svg).into_owned()
+        })
+        .collect();
+    crate::export::preview::preview_page(&crate::export::preview::PreviewInput {
+        name,
+        manifest,
+        sheets: &sheets,
+        map,
+    })
 }
 
 /// Sheet `index` of `layout` in every format of the job, its files named `stem`.ext,

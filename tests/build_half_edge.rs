@@ -776,6 +776,7 @@ fn the_manifest_names_the_files_of_each_format() {
         }
         wanted.push("genus2-assembled.obj".into());
         wanted.push("genus2-map.svg".into());
+        wanted.push("genus2.html".into());
         wanted.push("manifest.json".into());
         let listed: Vec<&str> = m["files"]
             .as_array()

@@ -335,8 +335,9 @@ fn an_older_manifest_does_not_make_the_users_dxf_files_ours() {
         sheet.insert("file".into(), svg);
     }
     std::fs::write(&path, serde_json::to_string_pretty(&manifest).unwrap()).unwrap();
-    // Nor did they draw an assembly map.
+    // Nor did they draw an assembly map or a preview page.
     std::fs::remove_file(out.join("tetrahedron-map.svg")).unwrap();
+    std::fs::remove_file(out.join("tetrahedron.html")).unwrap();
     std::fs::write(out.join("tetrahedron-01.dxf"), "my own drawing\n").unwrap();
     let before = tree(tmp.path());
     let run = build(&model("tetrahedron"), &out, &[]);

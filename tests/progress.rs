@@ -35,7 +35,7 @@ fn progress_shows_on_a_terminal_and_never_in_a_log() {
         .unwrap();
     assert!(run.success());
     let logged = std::fs::read_to_string(&log).unwrap();
-    assert!(logged.contains("wrote 5 files"), "{logged}");
+    assert!(logged.contains("wrote 6 files"), "{logged}");
     for sign in ["nesting", "\r", "\u{1b}["] {
         assert!(!logged.contains(sign), "{sign:?} in a file:\n{logged}");
     }
@@ -73,7 +73,7 @@ fn progress_shows_on_a_terminal_and_never_in_a_log() {
     );
     assert!(shown.contains("writing 2 sheets ["), "{shown}");
     // The report still follows, and the spinner is cleared before it.
-    assert!(shown.contains("wrote 5 files"), "{shown}");
+    assert!(shown.contains("wrote 6 files"), "{shown}");
     // --quiet shows nothing, terminal or not.
     let quiet = Command::new("script")
         .args(["-qec", &format!("{line}-quiet --quiet"), "/dev/null"])

@@ -21,6 +21,7 @@ mod nesting;
 mod options_table;
 mod output_folder;
 mod planarize;
+mod preview;
 mod progress;
 mod sheet_checker_selftest;
 mod sheet_style;

@@ -108,6 +108,7 @@ pub fn option_defaults(registry: &Registry) -> Vec<OptionDefault> {
         ),
         D::words("force", "off"),
         D::words("no-map", "the map is written"),
+        D::words("no-preview", "the preview page is written"),
         D::value("labels", value_name(LABELS)),
         D::value("speeds", speeds_text(Speeds::default())),
         D::value("format", FORMAT),

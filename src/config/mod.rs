@@ -437,6 +437,12 @@ pub struct BuildOptions {
     #[serde(default)]
     pub no_map: bool,
 
+    /// Write no preview page (NAME.html: every sheet with visible strokes, the map and
+    /// the report's figures, for a browser).
+    #[arg(long)]
+    #[serde(default)]
+    pub no_preview: bool,
+
     /// The face the labels read on: outside, or inside (mirrored, for models assembled
     /// inside out or cut face down).
     #[arg(long, value_name = "SIDE")]
@@ -696,6 +702,8 @@ pub struct Job {
     pub force: bool,
     /// Write the assembly map beside the sheets.
     pub map: bool,
+    /// Write the preview page beside the sheets.
+    pub preview: bool,
     /// Refuse instead of warning about the build's size.
     pub strict: bool,
     /// Build a model too detailed for its size instead of stopping.
@@ -772,6 +780,7 @@ impl BuildOptions {
             out: self.out.or(other.out),
             force: self.force || other.force,
             no_map: self.no_map || other.no_map,
+            no_preview: self.no_preview || other.no_preview,
             format: self.format.or(other.format),
             face_scale: self.face_scale.or(other.face_scale),
             holes: self.holes.or(other.holes),
@@ -850,6 +859,7 @@ impl BuildOptions {
             out: self.out_folder(model_path),
             force: self.force,
             map: !self.no_map,
+            preview: !self.no_preview,
             strict: self.strict,
             build_anyway: self.build_anyway,
             json: self.json,

@@ -10,6 +10,7 @@ pub mod manifest;
 pub mod map;
 pub mod map_page;
 pub mod obj;
+pub mod preview;
 pub mod report;
 pub mod svg;
 

@@ -520,13 +520,14 @@ pub fn check_output(
     let sheets = count(m, "counts.sheets");
     assert!(sheets >= 1, "{what}: no sheets");
 
-    // The files: one SVG and one DXF per sheet, the manifest, the assembled model and
-    // the assembly map.
+    // The files: one SVG and one DXF per sheet, the manifest, the assembled model, the
+    // assembly map and the preview page.
     let digits = sheets.to_string().len().max(2);
     let mut expected = BTreeSet::from([
         "manifest.json".to_string(),
         format!("{name}-assembled.obj"),
         format!("{name}-map.svg"),
+        format!("{name}.html"),
     ]);
     for k in 1..=sheets {
         expected.insert(format!("{name}-{k:0digits$}.svg"));
