@@ -399,22 +399,29 @@ mod tests {
         }
     }
 
-    /// A 20 mm square facet hinged to a 0.2 mm wide strip folded up by 90°.
-    fn square_and_strip(labels: Vec<Label>) -> Panel {
+    /// A 20 mm square facet hinged along x = 20 to a strip 20 mm long whose far side
+    /// is `across` from the hinge.
+    fn square_beside(across: DVec3, labels: Vec<Label>) -> Panel {
+        let hinge = [DVec3::new(20.0, 0.0, 0.0), DVec3::new(20.0, 20.0, 0.0)];
         Panel::new(
             Source::edge(7),
             vec![
                 DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(20.0, 0.0, 0.0),
-                DVec3::new(20.0, 20.0, 0.0),
+                hinge[0],
+                hinge[1],
                 DVec3::new(0.0, 20.0, 0.0),
-                DVec3::new(20.0, 0.0, 0.2),
-                DVec3::new(20.0, 20.0, 0.2),
+                hinge[0] + across,
+                hinge[1] + across,
             ],
             [vec![0, 1, 2, 3], vec![1, 4, 5, 2]].into_iter().collect(),
             Vec::new(),
             labels,
         )
+    }
+
+    /// A 20 mm square facet hinged to a 0.2 mm wide strip folded up by 90°.
+    fn square_and_strip(labels: Vec<Label>) -> Panel {
+        square_beside(DVec3::new(0.0, 0.0, 0.2), labels)
     }
 
     #[test]
@@ -463,18 +470,8 @@ mod tests {
     fn no_label_is_larger_than_the_panels_own_id() {
         // A 20 mm square beside a 5 mm wide strip in its plane; the id is wanted on
         // the strip, where it fits only small, and a partner id 4 mm high on the square.
-        let panel = Panel::new(
-            Source::edge(7),
-            vec![
-                DVec3::new(0.0, 0.0, 0.0),
-                DVec3::new(20.0, 0.0, 0.0),
-                DVec3::new(20.0, 20.0, 0.0),
-                DVec3::new(0.0, 20.0, 0.0),
-                DVec3::new(25.0, 0.0, 0.0),
-                DVec3::new(25.0, 20.0, 0.0),
-            ],
-            [vec![0, 1, 2, 3], vec![1, 4, 5, 2]].into_iter().collect(),
-            Vec::new(),
+        let panel = square_beside(
+            DVec3::new(5.0, 0.0, 0.0),
             vec![
                 label(
                     Name::edge(7),

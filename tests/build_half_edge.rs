@@ -778,12 +778,7 @@ fn the_manifest_names_the_files_of_each_format() {
         wanted.push("genus2-map.svg".into());
         wanted.push("genus2.html".into());
         wanted.push("manifest.json".into());
-        let listed: Vec<&str> = m["files"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|f| f.as_str().unwrap())
-            .collect();
+        let listed = common::build::listed_files(&m);
         assert_eq!(listed, wanted, "--format {format}: the manifest's files");
         assert_eq!(
             entry_names(&out),

@@ -9,7 +9,7 @@ use crate::common;
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use common::build::{build, count, model, options, resolve, shared_models};
+use common::build::{build, count, listed_files, model, options, resolve, shared_models};
 use common::map::{face_seen, read_map};
 use serde_json::Value;
 use tempfile::TempDir;
@@ -45,12 +45,7 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
     let manifest = build(scheme, model, size, &out, &args);
     let stem = model.file_stem().unwrap().to_string_lossy();
     let map_name = format!("{stem}-map.svg");
-    let files: Vec<&str> = manifest["files"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f.as_str().unwrap())
-        .collect();
+    let files = listed_files(&manifest);
     assert!(files.contains(&map_name.as_str()), "{files:?}");
     let svg = std::fs::read_to_string(out.join(&map_name)).unwrap();
     let views = read_map(&svg);

@@ -14,8 +14,8 @@ use std::fmt::Write;
 
 use glam::{DVec2, DVec3};
 
-use super::fmt_mm;
-use super::map_page::{fit, text_width, Lines, Palette, LINE};
+use super::map_page::{fit, text_width, wrap, Lines, Palette, LINE};
+use super::{escape, fmt_mm};
 use crate::nest::Layout;
 use crate::panel::surface::{PanelSurface, Patch};
 use crate::panel::{IdKind, Panels};
@@ -599,13 +599,14 @@ fn legend(out: &mut String, map: &MapContext, page: &Page, named: usize) {
         );
     }
     // The key at the size the page was laid out for (the text is never longer).
-    let key = fit(
-        &key_text(input.panels, named),
-        page.width - 2.0 * BORDER,
-        page.key.size,
-        page.key.size,
-        1,
-    );
+    let key = Lines {
+        size: page.key.size,
+        lines: wrap(
+            &key_text(input.panels, named),
+            page.width - 2.0 * BORDER,
+            page.key.size,
+        ),
+    };
     let key_top = top + page.swatch_rows as f64 * SWATCH_ROW + GAP;
     text_lines(out, &key, DVec2::new(BORDER, key_top));
     out.push_str("</g>\n");
@@ -649,13 +650,6 @@ fn id_legend(panels: &Panels) -> String {
 
 fn vec3(v: DVec3) -> String {
     format!("{} {} {}", v.x, v.y, v.z)
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
 }
 
 /// A view's owner buffer: which panel is seen at each raster cell of its page cell.

@@ -76,7 +76,7 @@ pub fn fit(text: &str, width: f64, largest: f64, smallest: f64, most: usize) -> 
 
 /// `text` broken greedily at spaces into lines of at most `width` mm at `size`; a
 /// word wider than that is broken between characters.
-fn wrap(text: &str, width: f64, size: f64) -> Vec<String> {
+pub fn wrap(text: &str, width: f64, size: f64) -> Vec<String> {
     let mut lines: Vec<String> = Vec::new();
     let mut line = String::new();
     for word in text.split(' ').filter(|w| !w.is_empty()) {
@@ -243,7 +243,7 @@ mod tests {
     }
 
     #[test]
-    fn palette_colours_are_in_gamut_and_round_trip() {
+    fn white_converts_exactly_and_every_sheet_has_a_colour_at_any_facing() {
         let white = lab_to_srgb([100.0, 0.0, 0.0]).unwrap();
         assert_eq!(white, [255, 255, 255]);
         let palette = Palette::new(40);

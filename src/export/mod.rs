@@ -423,6 +423,14 @@ fn label_groups(panel: FlatPanelRef, placement: &Placement, inside: bool) -> Vec
     groups
 }
 
+/// Text made safe inside XML and HTML: the map's and the preview page's words.
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 /// A length in mm with at most 4 decimals, trailing zeros trimmed, never `-0`, never
 /// an exponent: identical input gives identical bytes. Rounds through an integer count
 /// of ten-thousandths (half away from zero), which is exact and far faster than

@@ -7,7 +7,9 @@
 
 use std::fmt::Write;
 
+use super::escape;
 use super::manifest::Manifest;
+use super::report::duration;
 use crate::units::count_of;
 
 /// What the page shows.
@@ -112,23 +114,6 @@ fn figures(out: &mut String, m: &Manifest) {
     out.push_str("</table>\n");
 }
 
-/// A duration in words: seconds below a minute, then minutes, then hours and minutes.
-fn duration(seconds: f64) -> String {
-    let s = seconds.max(0.0).round() as u64;
-    match s {
-        0..=59 => format!("{s} s"),
-        60..=3599 => format!("{} min", (s + 30) / 60),
-        _ => format!("{} h {} min", s / 3600, (s % 3600 + 30) / 60),
-    }
-}
-
-fn escape(text: &str) -> String {
-    text.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 /// Standard base64 (RFC 4648) with padding.
 fn base64(bytes: &[u8]) -> String {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -168,12 +153,5 @@ mod tests {
         ] {
             assert_eq!(base64(text.as_bytes()), encoded);
         }
-    }
-
-    #[test]
-    fn durations_read_naturally() {
-        assert_eq!(duration(44.2), "44 s");
-        assert_eq!(duration(1080.0), "18 min");
-        assert_eq!(duration(6.0 * 3600.0 + 20.0 * 60.0), "6 h 20 min");
     }
 }

@@ -20,7 +20,7 @@ pub struct Extras<'a> {
 }
 
 /// A time as a person says it: "42 s", "12 min", "5 h 40 min".
-fn duration(seconds: f64) -> String {
+pub(super) fn duration(seconds: f64) -> String {
     let s = seconds.max(0.0).round() as u64;
     if s < 60 {
         format!("{s} s")
@@ -166,4 +166,16 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         if dxf { " (DXF in millimetres)" } else { "" }
     );
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn durations_read_naturally() {
+        assert_eq!(duration(44.2), "44 s");
+        assert_eq!(duration(1080.0), "18 min");
+        assert_eq!(duration(6.0 * 3600.0 + 20.0 * 60.0), "6 h 20 min");
+    }
 }

@@ -7,7 +7,7 @@
 //! triangles like any other, and simplification may collapse across it.
 
 use super::build::{build_mesh, BuildError};
-use super::{Mesh, Polygons, VertexId};
+use super::{Mesh, Polygons};
 use glam::DVec3;
 
 /// What [`fill_holes`] closed.
@@ -132,34 +132,18 @@ fn close_loop(
 /// `mesh`'s faces and the `caps`, each vertex replaced by the one it was joined to
 /// and vertices no face uses left out.
 fn closed_with(mesh: &Mesh, caps: &[Vec<u32>], joined_to: &[u32]) -> Result<Mesh, BuildError> {
-    let faces: Vec<Vec<u32>> = mesh
+    let mut polys = Polygons::new();
+    polys.positions = mesh.positions().to_vec();
+    let faces = mesh
         .faces()
         .map(|f| mesh.face_vertices(f).map(|v| v.0).collect::<Vec<u32>>())
-        .chain(caps.iter().cloned())
-        .map(|corners| corners.into_iter().map(|v| root(joined_to, v)).collect())
-        .collect();
-    // Vertices renumbered in index order, those no face uses dropped.
-    let mut used = vec![false; mesh.vertex_count()];
-    faces
-        .iter()
-        .flatten()
-        .for_each(|&v| used[v as usize] = true);
-    let mut index = vec![u32::MAX; used.len()];
-    let mut polys = Polygons::new();
-    let mut vertex_source = Vec::new();
-    for v in (0..used.len()).filter(|&v| used[v]) {
-        index[v] = polys.positions.len() as u32;
-        polys.positions.push(mesh.positions()[v]);
-        vertex_source.push(mesh.vertex_source(VertexId(v as u32)));
+        .chain(caps.iter().cloned());
+    for corners in faces {
+        let joined: Vec<u32> = corners.into_iter().map(|v| root(joined_to, v)).collect();
+        polys.push_face(&joined);
     }
-    for corners in &faces {
-        polys.push_face(
-            &corners
-                .iter()
-                .map(|&v| index[v as usize])
-                .collect::<Vec<_>>(),
-        );
-    }
+    let sources: Vec<u32> = mesh.vertices().map(|v| mesh.vertex_source(v)).collect();
+    let (polys, vertex_source) = super::prepare::drop_unreferenced(polys, Some(&sources));
     let face_source: Vec<u32> = mesh
         .faces()
         .map(|f| mesh.face_source(f))

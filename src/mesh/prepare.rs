@@ -540,7 +540,10 @@ fn unused_vertices(polys: &Polygons) -> impl Iterator<Item = u32> + '_ {
 /// Compacts away vertices used by no face. `previous_source` maps the input soup's
 /// vertices to the file (identity when `None`); returns the new soup and its map to the
 /// file's vertices.
-fn drop_unreferenced(polys: Polygons, previous_source: Option<&[u32]>) -> (Polygons, Vec<u32>) {
+pub(super) fn drop_unreferenced(
+    polys: Polygons,
+    previous_source: Option<&[u32]>,
+) -> (Polygons, Vec<u32>) {
     let mut new_index = vec![u32::MAX; polys.positions.len()];
     let mut positions = Vec::new();
     let mut source = Vec::new();

@@ -164,6 +164,16 @@ pub fn build(scheme: &str, model: &Path, size: &str, out: &Path, extra: &[&str])
     build_run(scheme, model, size, out, extra).0
 }
 
+/// The files a manifest lists (`files`: every file the run wrote).
+pub fn listed_files(manifest: &Value) -> Vec<&str> {
+    manifest["files"]
+        .as_array()
+        .expect("the manifest lists its files")
+        .iter()
+        .map(|f| f.as_str().expect("a file name"))
+        .collect()
+}
+
 pub fn read_manifest(out: &Path) -> Value {
     let text = std::fs::read_to_string(out.join("manifest.json"))
         .unwrap_or_else(|e| panic!("{}/manifest.json: {e}", out.display()));
