@@ -584,12 +584,13 @@ pub fn export(
             name: &name,
         })
     });
-    if let Some(map) = &map {
-        files.push((format!("{name}-map.svg"), map.clone().into_bytes()));
+    let map = map.unwrap_or_default();
+    for (k, page) in map.iter().enumerate() {
+        files.push((map_file(&name, k), page.clone().into_bytes()));
     }
     manifest.warnings = warnings;
     if job.preview {
-        let page = preview(job, layout, panels, &name, &manifest, map.as_deref());
+        let page = preview(job, layout, panels, &name, &manifest, &map);
         files.push((format!("{name}.html"), page.into_bytes()));
     }
     manifest.files = files
@@ -603,6 +604,15 @@ pub fn export(
     Ok(Exported { files, manifest })
 }
 
+/// The file of page `k` (from 0) of the assembly map: `NAME-map.svg`, then
+/// `NAME-map-2.svg`…
+fn map_file(name: &str, k: usize) -> String {
+    match k {
+        0 => format!("{name}-map.svg"),
+        _ => format!("{name}-map-{}.svg", k + 1),
+    }
+}
+
 /// The preview page ([`crate::export::preview`]): every sheet drawn again with strokes
 /// wide enough to see, beside the map and the manifest's figures.
 fn preview(
@@ -611,7 +621,7 @@ fn preview(
     panels: &FlatPanels,
     name: &str,
     manifest: &Manifest,
-    map: Option<&str>,
+    map: &[String],
 ) -> String {
     let mut style = job.style.clone();
     let stroke = crate::export::preview::preview_stroke(layout.sheet.width);

@@ -225,12 +225,7 @@ fn no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme() {
     else {
         return;
     };
-    let mut models: Vec<_> = std::fs::read_dir(&shared)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "obj" || x == "off"))
-        .collect();
-    models.sort();
+    let models = common::build::shared_model_files(&shared);
     // The README's build: 4 ft at the thesis budget of 625 edges; and 2 ft, where the
     // panels are small and the labels compete for room.
     let mut surveyed = 0;

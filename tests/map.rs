@@ -1,5 +1,5 @@
-//! The assembly map (`NAME-map.svg`), read back as a builder would use it: it names
-//! nearly every panel, each id where its panel is seen — checked by casting a ray
+//! The assembly map (`NAME-map.svg` and its close-up pages), read back as a builder
+//! would use it: it names every panel, each id where its panel is seen — checked by casting a ray
 //! into the model (the scheme's mesh, from the library's pipeline) at the id's place
 //! on the page, through the view's own projection written on the view's group — and
 //! `--no-map` turns it off.
@@ -10,7 +10,8 @@ use std::collections::BTreeSet;
 use std::path::Path;
 
 use common::build::{build, count, listed_files, model, options, resolve, shared_models};
-use common::map::{face_seen, read_map};
+use common::map::{face_seen, map_pages, read_map, MapView};
+use glam::DVec2;
 use serde_json::Value;
 use tempfile::TempDir;
 use unfold::mesh::{EdgeId, FaceId, Mesh};
@@ -32,25 +33,40 @@ fn faces_of(mesh: &Mesh, id: &str) -> BTreeSet<u32> {
     }
 }
 
-/// Builds `model` with `args`, reads its map, and checks that at least `share` of the
-/// panels are named and that every id sits over a face of its own panel as seen.
-fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>, share: f64) {
+/// Builds `model` with `args`, reads every page of its map, and checks that every
+/// panel is named and that every id sits over a face of its own panel as seen: the
+/// overview's six views, then the close-ups, each id inside its close-up's frame.
+fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>, args: &[&str]) {
     let tmp = TempDir::new().unwrap();
     let out = tmp.path().join("out");
-    let mut args = vec!["--nester", "shelf"];
+    let mut all = vec!["--nester", "shelf"];
+    all.extend(args);
     let budget = target_edges.map(|t| t.to_string());
     if let Some(b) = &budget {
-        args.extend(["--target-edges", b]);
+        all.extend(["--target-edges", b]);
     }
-    let manifest = build(scheme, model, size, &out, &args);
+    let manifest = build(scheme, model, size, &out, &all);
     let stem = model.file_stem().unwrap().to_string_lossy();
-    let map_name = format!("{stem}-map.svg");
     let files = listed_files(&manifest);
-    assert!(files.contains(&map_name.as_str()), "{files:?}");
-    let svg = std::fs::read_to_string(out.join(&map_name)).unwrap();
-    let views = read_map(&svg);
+    assert!(
+        files.contains(&format!("{stem}-map.svg").as_str()),
+        "{files:?}"
+    );
+    let pages = map_pages(&out, &files);
+    // The preview page shows every page of the map.
+    let html = std::fs::read_to_string(out.join(format!("{stem}.html"))).unwrap();
+    assert_eq!(html.matches("class=\"map\"").count(), pages.len());
+    let views: Vec<MapView> = pages.iter().flat_map(|svg| read_map(svg)).collect();
     let names: Vec<&str> = views.iter().map(|v| v.name.as_str()).collect();
-    assert_eq!(names, ["front", "back", "left", "right", "top", "bottom"]);
+    assert_eq!(
+        names[..6],
+        ["front", "back", "left", "right", "top", "bottom"]
+    );
+    for (k, name) in names[6..].iter().enumerate() {
+        assert_eq!(*name, format!("close-up {}", k + 1));
+    }
+    let frames: Vec<(DVec2, DVec2)> = pages.iter().flat_map(|svg| close_up_frames(svg)).collect();
+    assert_eq!(frames.len(), views.len() - 6, "a frame for every close-up");
 
     let panel_ids: BTreeSet<String> = manifest["panels"]
         .as_array()
@@ -67,7 +83,7 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
 
     let mut named = BTreeSet::new();
     let mut checked = 0;
-    for view in &views {
+    for (k, view) in views.iter().enumerate() {
         for (id, at) in &view.ids {
             assert!(panel_ids.contains(id), "{}: {id} is no panel", view.name);
             let seen = face_seen(&mesh, view, *at);
@@ -77,41 +93,95 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
                 "{} view: {id} at {at} is drawn over face {seen:?}, not its own {own:?}",
                 view.name
             );
+            if let Some((lo, hi)) = k.checked_sub(6).map(|c| frames[c]) {
+                assert!(
+                    at.cmpge(lo).all() && at.cmple(hi).all(),
+                    "{}: {id} at {at} is outside its frame",
+                    view.name
+                );
+            }
             named.insert(id.clone());
             checked += 1;
         }
     }
     eprintln!(
-        "{stem}: {} of {} panels named, {checked} ids checked",
+        "{stem} {scheme}: {} of {} panels named, {checked} ids checked, {} close-ups on {} pages",
         named.len(),
-        panel_ids.len()
+        panel_ids.len(),
+        views.len() - 6,
+        pages.len()
     );
+    let unnamed: Vec<&String> = panel_ids.difference(&named).collect();
     assert!(
-        named.len() as f64 >= share * panel_ids.len() as f64,
-        "{stem}: {} of {} panels named",
-        named.len(),
-        panel_ids.len()
+        unnamed.is_empty(),
+        "{stem} {scheme}: not on the map: {unnamed:?}"
     );
+}
+
+/// The frame of each close-up on a page (its clip rectangle), in order.
+fn close_up_frames(svg: &str) -> Vec<(DVec2, DVec2)> {
+    svg.split("<clipPath id=\"clip-close-up-")
+        .skip(1)
+        .map(|chunk| {
+            let rect = &chunk[chunk.find("<rect").unwrap()..chunk.find("/>").unwrap()];
+            let n = |name: &str| -> f64 { common::map::attribute(rect, name).parse().unwrap() };
+            let lo = DVec2::new(n("x"), n("y"));
+            (lo, lo + DVec2::new(n("width"), n("height")))
+        })
+        .collect()
 }
 
 #[test]
 fn the_map_of_genus3_names_its_faces_where_they_are_seen() {
-    check_map(&model("genus3"), "half-edge", "300mm", None, 0.95);
+    check_map(&model("genus3"), "half-edge", "300mm", None, &[]);
+}
+
+/// The README's bunny (quad-edge, 4 ft, 625 edges) with `args`, checked by `test`.
+fn check_thesis_bunny(test: &str, args: &[&str]) {
+    if let Some(shared) = shared_models(test) {
+        let bunny = shared.join("stanford-bunny.obj");
+        check_map(&bunny, "quad-edge", "4ft", Some(625), args);
+    }
 }
 
 #[test]
 fn the_map_of_the_thesis_bunny_names_its_edges_where_they_are_seen() {
-    let Some(shared) =
-        shared_models("the_map_of_the_thesis_bunny_names_its_edges_where_they_are_seen")
-    else {
+    check_thesis_bunny(
+        "the_map_of_the_thesis_bunny_names_its_edges_where_they_are_seen",
+        &[],
+    );
+}
+
+/// Every shared model at a thesis-like budget, edge and face panels: the overview
+/// names most panels and the close-ups the rest (the cube's faces are larger than any
+/// listed sheet at 4 ft, so it goes on a 1.5 m sheet).
+#[test]
+fn every_panel_of_every_shared_model_is_on_the_map() {
+    let Some(shared) = shared_models("every_panel_of_every_shared_model_is_on_the_map") else {
         return;
     };
-    check_map(
-        &shared.join("stanford-bunny.obj"),
-        "quad-edge",
-        "4ft",
-        Some(625),
-        0.95,
+    let models = common::build::shared_model_files(&shared);
+    assert!(models.len() >= 8, "{models:?}");
+    for model in &models {
+        let cube = model.file_stem().is_some_and(|s| s == "cube");
+        let args: &[&str] = if cube {
+            &["--sheet", "1500x1500mm"]
+        } else {
+            &[]
+        };
+        for scheme in ["quad-edge", "half-edge"] {
+            check_map(model, scheme, "4ft", Some(1000), args);
+        }
+    }
+}
+
+/// On A4 the overview of the thesis bunny has room for about two thirds of its ids;
+/// close-up pages name the rest.
+#[test]
+fn on_a4_close_ups_name_what_the_overview_has_no_room_for() {
+    check_thesis_bunny(
+        "on_a4_close_ups_name_what_the_overview_has_no_room_for",
+        &["--sheet", "A4"],
     );
 }
 
@@ -126,18 +196,14 @@ fn woven_segments_are_named_along_their_ribbons() {
         &out,
         &["--nester", "shelf"],
     );
-    let svg = std::fs::read_to_string(out.join("torus-6x4-map.svg")).unwrap();
-    let named: BTreeSet<String> = read_map(&svg)
-        .into_iter()
+    let named: BTreeSet<String> = map_pages(&out, &listed_files(&manifest))
+        .iter()
+        .flat_map(|svg| read_map(svg))
         .flat_map(|v| v.ids.into_iter().map(|(id, _)| id))
         .collect();
     let panels = count(&manifest, "counts.panels");
     assert!(named.iter().all(|id| id.starts_with('C')), "{named:?}");
-    assert!(
-        named.len() * 100 >= 95 * panels,
-        "{} of {panels}",
-        named.len()
-    );
+    assert_eq!(named.len(), panels);
 }
 
 #[test]
@@ -262,9 +328,10 @@ fn check_page(case: &str, svg: &str, width: f64, height: f64, sheets: usize) {
             );
         }
     }
-    // Each view's drawing (its patches' corners), against the others and the page's
-    // text (its caption included).
-    let drawings: Vec<(glam::DVec2, glam::DVec2)> = svg
+    // Each view's drawing (its patches' corners, or a close-up's frame, which clips
+    // it), against the others and the page's text (its caption included).
+    let frames = close_up_frames(svg);
+    let overview: Vec<(glam::DVec2, glam::DVec2)> = svg
         .split("<g id=\"view-")
         .skip(1)
         .map(|chunk| {
@@ -286,7 +353,13 @@ fn check_page(case: &str, svg: &str, width: f64, height: f64, sheets: usize) {
             (lo, hi)
         })
         .collect();
-    assert_eq!(drawings.len(), 6, "{case}");
+    let drawings = if frames.is_empty() {
+        assert_eq!(overview.len(), 6, "{case}");
+        overview
+    } else {
+        assert_eq!(frames.len(), overview.len(), "{case}: a frame per close-up");
+        frames
+    };
     for (i, &a) in drawings.iter().enumerate() {
         assert!(
             a.0.x >= 0.0 && a.0.y >= 0.0 && a.1.x <= width && a.1.y <= height,
@@ -368,19 +441,21 @@ fn the_map_fits_every_paper_for_any_number_of_sheets() {
                     })
                     .collect(),
             };
-            let svg = unfold::export::map::assembly_map(&unfold::export::map::MapInput {
+            let pages = unfold::export::map::assembly_map(&unfold::export::map::MapInput {
                 surface: &surface,
                 panels: &p.output.panels,
                 layout: &layout,
                 name: "torus-8x6-as-downloaded-from-a-public-collection",
             });
-            check_page(
-                &format!("{paper}, {sheets} sheets"),
-                &svg,
-                size.width,
-                size.height,
-                sheets,
-            );
+            for (k, svg) in pages.iter().enumerate() {
+                check_page(
+                    &format!("{paper}, {sheets} sheets, page {}", k + 1),
+                    svg,
+                    size.width,
+                    size.height,
+                    sheets,
+                );
+            }
         }
     }
 }

@@ -80,12 +80,7 @@ fn every_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
         .filter(|p| p.extension().is_some_and(|x| x == "obj"))
         .collect();
     if let Some(dir) = shared_models("every_model_scheme_kerf_and_mirror_builds") {
-        let mut shared: Vec<PathBuf> = std::fs::read_dir(dir)
-            .unwrap()
-            .map(|e| e.unwrap().path())
-            .filter(|p| p.extension().is_some_and(|x| x == "obj" || x == "off"))
-            .collect();
-        shared.sort();
+        let shared = common::build::shared_model_files(&dir);
         models.extend(shared.iter().map(|m| sweep_model(m, tmp.path())));
     }
     models.sort();

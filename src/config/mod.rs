@@ -432,7 +432,7 @@ pub struct BuildOptions {
     pub force: bool,
 
     /// Write no assembly map (NAME-map.svg: the model from six sides, each panel's id
-    /// where it sits, tinted by its sheet).
+    /// where it sits, tinted by its sheet; NAME-map-2.svg…: close-ups naming the rest).
     #[arg(long)]
     #[serde(default)]
     pub no_map: bool,

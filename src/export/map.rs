@@ -21,15 +21,15 @@ use crate::panel::surface::{PanelSurface, Patch};
 use crate::panel::{IdKind, Panels};
 
 /// A direction the model is seen from.
-struct View {
-    name: &'static str,
+pub(super) struct View {
+    pub name: &'static str,
     /// The axis it is seen from and the way it turns off it, for the caption.
-    axis: &'static str,
-    turn: &'static str,
+    pub axis: &'static str,
+    pub turn: &'static str,
     /// From the model toward the viewer (unit).
-    toward: DVec3,
+    pub toward: DVec3,
     /// Up on the page (unit, square to `toward`).
-    up: DVec3,
+    pub up: DVec3,
 }
 
 impl View {
@@ -74,7 +74,7 @@ fn axis_vector(axis: &str) -> DVec3 {
 
 /// The six views, in the order they are laid out (the model's +Y is up, +Z toward
 /// the front).
-fn views() -> [View; 6] {
+pub(super) fn views() -> [View; 6] {
     let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
     [
         View::new("front", ["+Z", "+X and +Y"], x + y, y),
@@ -100,14 +100,14 @@ const BORDER: f64 = 8.0;
 /// Text heights (mm) of the page furniture: the largest each is set at, and the
 /// smallest it shrinks to before it wraps onto more lines.
 const TITLE_TEXT: [f64; 2] = [6.0, 3.0];
-const CAPTION_TEXT: [f64; 2] = [4.5, 2.2];
+pub(super) const CAPTION_TEXT: [f64; 2] = [4.5, 2.2];
 const LEGEND_TEXT: [f64; 2] = [3.5, 2.5];
 
 /// A legend row of sheet swatches (mm).
 const SWATCH_ROW: f64 = 5.5;
 
 /// Space (mm) below a block of text before what follows it.
-const GAP: f64 = 1.5;
+pub(super) const GAP: f64 = 1.5;
 
 /// What the map is drawn from.
 pub struct MapInput<'a> {
@@ -121,8 +121,10 @@ pub struct MapInput<'a> {
     pub name: &'a str,
 }
 
-/// The assembly map as an SVG document, on a page of the sheet's size.
-pub fn assembly_map(input: &MapInput) -> String {
+/// The assembly map as SVG pages of the sheet's size: the overview (six views), then,
+/// where the overview has no room for some ids, pages of close-ups until every panel
+/// is named ([`super::map_closeup`]).
+pub fn assembly_map(input: &MapInput) -> Vec<String> {
     let patches = &input.surface.patches;
     let mut sheet_of = vec![0; input.panels.len()];
     for p in &input.layout.placements {
@@ -138,7 +140,11 @@ pub fn assembly_map(input: &MapInput) -> String {
         .iter()
         .map(|v| bounds(patches.iter().flat_map(|p| &p.points), v))
         .collect();
-    let page = Page::new(input);
+    let page = Page::new(
+        input,
+        &title_text(input),
+        &key_text(input.panels, [input.panels.len(); 2], input.panels.len()),
+    );
     let grid = Grid::largest(&page, &views, &extents);
     let map = MapContext {
         input,
@@ -155,9 +161,84 @@ pub fn assembly_map(input: &MapInput) -> String {
     for (k, view) in views.iter().enumerate() {
         draw_view(&mut out, &map, k, view, extents[k], &mut named);
     }
-    legend(&mut out, &map, &page, named.iter().filter(|&&n| n).count());
+    let count = |named: &[bool]| named.iter().filter(|&&n| n).count();
+    let on_overview = count(&named);
+    let close_ups = close_up_pages(&map, &mut named);
+    let pages = match close_ups.len() {
+        0 => 0,
+        more => more + 1,
+    };
+    let closer = count(&named) - on_overview;
+    let key = key_text(input.panels, [on_overview, closer], pages);
+    legend(&mut out, &map, &page, &key);
     out.push_str("</svg>\n");
-    out
+    std::iter::once(out).chain(close_ups).collect()
+}
+
+/// The pages of close-ups of the panels the overview left unnamed, each page laid out
+/// like the overview: title, cells of close-ups, the sheets' tints and a key.
+fn close_up_pages(map: &MapContext, named: &mut [bool]) -> Vec<String> {
+    if named.iter().all(|&n| n) {
+        return Vec::new();
+    }
+    let input = map.input;
+    let key = close_up_key(input.panels);
+    let page = Page::new(input, &close_up_title(input, 99, 99), &key);
+    let cells = CloseUpCells::new(&page);
+    let drawn = super::map_closeup::close_ups(map, &cells, named);
+    let count = drawn.len().div_ceil(cells.per_page());
+    drawn
+        .chunks(cells.per_page())
+        .enumerate()
+        .map(|(k, chunk)| {
+            let page = Page::new(input, &close_up_title(input, k + 2, count + 1), &key);
+            let mut out = String::new();
+            page_head(&mut out, &page);
+            for cell in chunk {
+                out.push_str(cell);
+            }
+            legend(&mut out, map, &page, &key);
+            out.push_str("</svg>\n");
+            out
+        })
+        .collect()
+}
+
+/// Where a page of close-ups puts them: a grid of cells over the views' area, each at
+/// least [`CLOSE_UP_CELL`] on a side where the paper allows.
+pub(super) struct CloseUpCells {
+    pub lo: DVec2,
+    pub cols: usize,
+    pub rows: usize,
+    pub cell: DVec2,
+}
+
+/// The smallest side (mm) of a close-up's cell, paper allowing: room for a region of
+/// a few panels around the one it shows.
+const CLOSE_UP_CELL: f64 = 80.0;
+
+impl CloseUpCells {
+    fn new(page: &Page) -> CloseUpCells {
+        let (lo, area) = page.views_area();
+        let count = |length: f64| ((length / CLOSE_UP_CELL).floor() as usize).clamp(1, 3);
+        let (cols, rows) = (count(area.x), count(area.y));
+        CloseUpCells {
+            lo,
+            cols,
+            rows,
+            cell: DVec2::new(area.x / cols as f64, area.y / rows as f64),
+        }
+    }
+
+    pub fn per_page(&self) -> usize {
+        self.cols * self.rows
+    }
+
+    /// The top-left corner of close-up `k`'s cell on its page.
+    pub fn corner(&self, k: usize) -> DVec2 {
+        let k = k % self.per_page();
+        self.lo + DVec2::new((k % self.cols) as f64, (k / self.cols) as f64) * self.cell
+    }
 }
 
 /// The page and its furniture, measured: the title at the top, the legend at the foot
@@ -174,22 +255,16 @@ struct Page {
 }
 
 impl Page {
-    fn new(input: &MapInput) -> Page {
+    /// The page for `input` with `title`, and room for `key` (or any shorter text).
+    fn new(input: &MapInput, title: &str, key: &str) -> Page {
         let (width, height) = page_size(input);
         let text_w = width - 2.0 * BORDER;
-        let title = fit(&title_text(input), text_w, TITLE_TEXT[0], TITLE_TEXT[1], 2);
+        let title = fit(title, text_w, TITLE_TEXT[0], TITLE_TEXT[1], 2);
         let sheets = input.layout.sheets.max(1);
         let entry = swatch_width(sheets);
         let room = text_w - text_width(SHEETS_WORD, LEGEND_TEXT[0]);
         let swatches_per_row = ((room / entry).floor() as usize).max(1);
-        // The key as long as it can be: every panel named.
-        let key = fit(
-            &key_text(input.panels, input.panels.len()),
-            text_w,
-            LEGEND_TEXT[0],
-            LEGEND_TEXT[1],
-            3,
-        );
+        let key = fit(key, text_w, LEGEND_TEXT[0], LEGEND_TEXT[1], 3);
         Page {
             width,
             height,
@@ -251,24 +326,24 @@ fn caption_text(view: &View) -> String {
 }
 
 /// What every view of a map is drawn with.
-struct MapContext<'a> {
-    input: &'a MapInput<'a>,
+pub(super) struct MapContext<'a> {
+    pub input: &'a MapInput<'a>,
     /// Each panel's sheet (its tint).
     sheet_of: Vec<usize>,
     /// Each panel's patches, as indices into the surface's.
-    panel_patches: Vec<Vec<usize>>,
-    grid: Grid,
+    pub panel_patches: Vec<Vec<usize>>,
+    pub grid: Grid,
     /// The ids' text height (mm).
-    text: f64,
+    pub text: f64,
     /// The sheets' tints.
     palette: Palette,
 }
 
 /// The page's grid of views and the one scale they share.
-struct Grid {
+pub(super) struct Grid {
     cols: usize,
     /// Page mm per model mm.
-    scale: f64,
+    pub scale: f64,
     /// The top-left corner of the views' area.
     lo: DVec2,
     cell_w: f64,
@@ -349,7 +424,7 @@ fn page_head(out: &mut String, page: &Page) {
 }
 
 /// Writes `lines` left-aligned, the first line's top at `top_left`.
-fn text_lines(out: &mut String, lines: &Lines, top_left: DVec2) {
+pub(super) fn text_lines(out: &mut String, lines: &Lines, top_left: DVec2) {
     for (i, line) in lines.lines.iter().enumerate() {
         // A line's baseline sits a cap height and a little below its top.
         let baseline = top_left.y + (i as f64 * LINE + 1.0) * lines.size;
@@ -379,48 +454,97 @@ fn draw_view(
     let (col, row) = (k % grid.cols, k / grid.cols);
     let cell_lo = grid.lo + DVec2::new(col as f64 * grid.cell_w, row as f64 * grid.cell_h);
     let centre = 0.5 * (lo + hi);
-    // Page point of a model point: the view's (right, up) scaled, y down, centred in
-    // the cell below its caption.
+    // The model's centre in the middle of the cell below its caption.
     let scale = grid.scale;
     let drawing_mid = grid.caption_h + 0.5 * (grid.cell_h - grid.caption_h - GAP);
-    let origin = cell_lo + DVec2::new(0.5 * grid.cell_w, drawing_mid)
-        - scale * DVec2::new(centre.x, -centre.y);
-    let to_page = |p: DVec3| {
-        let q = project(p, view);
-        origin + scale * DVec2::new(q.x, -q.y)
+    let frame = Frame {
+        view,
+        origin: cell_lo + DVec2::new(0.5 * grid.cell_w, drawing_mid)
+            - scale * DVec2::new(centre.x, -centre.y),
+        scale,
+        area: (cell_lo, DVec2::new(grid.cell_w, grid.cell_h)),
+        contain: false,
     };
     let _ = writeln!(
         out,
-        "<g id=\"view-{name}\" data-view=\"{name}\" data-toward=\"{}\" data-up=\"{}\" data-scale=\"{}\" data-origin=\"{} {}\">",
-        vec3(view.toward),
-        vec3(view.up),
-        scale,
-        origin.x,
-        origin.y,
+        "<g id=\"view-{name}\" data-view=\"{name}\" {}>",
+        frame.projection(),
         name = view.name
     );
     text_lines(out, &grid.captions[k], cell_lo + DVec2::new(2.0, 0.0));
-    let order = far_to_near(map.input.surface, view);
-    draw_patches(out, map, &order, view, &to_page);
-    let raster = Raster::new(cell_lo, DVec2::new(grid.cell_w, grid.cell_h));
-    let owners = raster.owners(&map.input.surface.patches, &order, view, &to_page);
+    let surface = map.input.surface;
+    draw_frame(out, map, &frame, &surface.patches, named, None);
+    out.push_str("</g>\n");
+}
+
+/// A view in its place on the page.
+pub(super) struct Frame<'a> {
+    pub view: &'a View,
+    /// The page point of the model's origin.
+    pub origin: DVec2,
+    /// Page mm per model mm.
+    pub scale: f64,
+    /// Where on the page ids may go: top-left corner and size.
+    pub area: (DVec2, DVec2),
+    /// Ids must lie wholly inside `area` (a close-up's drawing runs past it).
+    pub contain: bool,
+}
+
+impl Frame<'_> {
+    /// Where a model point lands on the page: the view's (right, up) scaled, y down.
+    pub fn to_page(&self, p: DVec3) -> DVec2 {
+        let q = project(p, self.view);
+        self.origin + self.scale * DVec2::new(q.x, -q.y)
+    }
+
+    /// The projection's attributes, for readers that map page points back.
+    pub fn projection(&self) -> String {
+        format!(
+            "data-toward=\"{}\" data-up=\"{}\" data-scale=\"{}\" data-origin=\"{} {}\"",
+            vec3(self.view.toward),
+            vec3(self.view.up),
+            self.scale,
+            self.origin.x,
+            self.origin.y
+        )
+    }
+}
+
+/// `patches` (the model's, or a close-up's cut from them) drawn in `frame` far to
+/// near, `first` outlined, then the ids of the panels seen, `first` before any other;
+/// returns whether `first` was named.
+pub(super) fn draw_frame(
+    out: &mut String,
+    map: &MapContext,
+    frame: &Frame,
+    patches: &[Patch],
+    named: &mut [bool],
+    first: Option<usize>,
+) -> bool {
+    let to_page = |p: DVec3| frame.to_page(p);
+    let order = far_to_near(patches, map.input.surface.closed, frame.view);
+    draw_patches(out, map, patches, &order, frame.view, &to_page);
+    if let Some(first) = first {
+        outline(out, patches, &order, first, &to_page);
+    }
+    let raster = Raster::new(frame.area.0, frame.area.1);
+    let owners = raster.owners(patches, &order, frame.view, &to_page);
     let seen = SeenPanels {
         raster: &raster,
         owners: &owners,
         to_page: &to_page,
+        contain: frame.contain.then_some(frame.area),
     };
-    name_panels(out, map, &seen, named);
-    out.push_str("</g>\n");
+    name_panels(out, map, &seen, named, first)
 }
 
 /// The patches a view may see, far to near (depth, index); back faces of a closed
 /// model are never seen.
-fn far_to_near(surface: &PanelSurface, view: &View) -> Vec<(f64, usize)> {
-    let mut order: Vec<(f64, usize)> = surface
-        .patches
+fn far_to_near(patches: &[Patch], closed: bool, view: &View) -> Vec<(f64, usize)> {
+    let mut order: Vec<(f64, usize)> = patches
         .iter()
         .enumerate()
-        .filter(|(_, p)| !surface.closed || p.normal.dot(view.toward) > 1e-9)
+        .filter(|(_, p)| !closed || p.normal.dot(view.toward) > 1e-9)
         .map(|(i, p)| {
             let depth =
                 p.points.iter().map(|q| q.dot(view.toward)).sum::<f64>() / p.points.len() as f64;
@@ -436,12 +560,13 @@ fn far_to_near(surface: &PanelSurface, view: &View) -> Vec<(f64, usize)> {
 fn draw_patches(
     out: &mut String,
     map: &MapContext,
+    patches: &[Patch],
     order: &[(f64, usize)],
     view: &View,
     to_page: &dyn Fn(DVec3) -> DVec2,
 ) {
     for &(_, i) in order {
-        let patch = &map.input.surface.patches[i];
+        let patch = &patches[i];
         let facing = patch.normal.dot(view.toward);
         let fill = map.palette.colour(map.sheet_of[patch.panel], facing);
         let mut d = String::new();
@@ -462,16 +587,58 @@ fn draw_patches(
     }
 }
 
+/// The drawn patches of `panel` outlined, so a close-up's own panel stands out.
+fn outline(
+    out: &mut String,
+    patches: &[Patch],
+    order: &[(f64, usize)],
+    panel: usize,
+    to_page: &dyn Fn(DVec3) -> DVec2,
+) {
+    for &(_, i) in order.iter().filter(|&&(_, i)| patches[i].panel == panel) {
+        let d: Vec<String> = patches[i]
+            .points
+            .iter()
+            .map(|&p| {
+                let q = to_page(p);
+                format!("{} {}", fmt_mm(q.x), fmt_mm(q.y))
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "<path d=\"M{} Z\" fill=\"none\" stroke=\"#202020\" stroke-width=\"0.4\" stroke-linejoin=\"round\"/>",
+            d.join(" L")
+        );
+    }
+}
+
 /// Which panel a view shows where, and where a model point lands on the page.
 struct SeenPanels<'a> {
     raster: &'a Raster,
     owners: &'a [Option<u32>],
     to_page: &'a dyn Fn(DVec3) -> DVec2,
+    /// The box ids must lie in (top-left corner and size), if any.
+    contain: Option<(DVec2, DVec2)>,
+}
+
+impl SeenPanels<'_> {
+    /// Whether an id's box `lo..hi` may go here.
+    fn contains(&self, lo: DVec2, hi: DVec2) -> bool {
+        self.contain
+            .is_none_or(|(corner, size)| lo.cmpge(corner).all() && hi.cmple(corner + size).all())
+    }
 }
 
 /// Writes the id of every panel the view shows, where its own panel is seen and no
-/// other id is: panels not yet named in an earlier view first, then the best seen.
-fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mut [bool]) {
+/// other id is: `first`, then panels not yet named in an earlier view, then the best
+/// seen. Returns whether `first` was named.
+fn name_panels(
+    out: &mut String,
+    map: &MapContext,
+    seen: &SeenPanels,
+    named: &mut [bool],
+    first: Option<usize>,
+) -> bool {
     let (panels, patches) = (map.input.panels, &map.input.surface.patches);
     let text = map.text;
     let mut cells = vec![0usize; panels.len()];
@@ -479,7 +646,11 @@ fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mu
         cells[o as usize] += 1;
     }
     let mut candidates: Vec<usize> = (0..panels.len()).filter(|&p| cells[p] > 0).collect();
-    candidates.sort_by(|&a, &b| (named[a], cells[b], a).cmp(&(named[b], cells[a], b)));
+    let later = |p: usize| Some(p) != first;
+    candidates.sort_by(|&a, &b| {
+        (later(a), named[a], cells[b], a).cmp(&(later(b), named[b], cells[a], b))
+    });
+    let mut first_named = false;
     let mut placed = Placed::new(text * 4.0);
     for p in candidates {
         let id = panels.get(p).id().to_string();
@@ -490,12 +661,14 @@ fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mu
             .map(seen.to_page)
             .find(|&at| {
                 seen.raster.owner_at(seen.owners, at) == Some(p as u32)
+                    && seen.contains(at - half, at + half)
                     && placed.try_add(at - half, at + half, 0.25 * text)
             });
         let Some(at) = spot else {
             continue;
         };
         named[p] = true;
+        first_named |= !later(p);
         let _ = writeln!(
             out,
             "<text x=\"{}\" y=\"{}\" font-size=\"{}\" text-anchor=\"middle\" dy=\"0.35em\" stroke=\"#FFFFFF\" stroke-width=\"{}\" paint-order=\"stroke\">{id}</text>",
@@ -505,26 +678,37 @@ fn name_panels(out: &mut String, map: &MapContext, seen: &SeenPanels, named: &mu
             fmt_mm(0.25 * text)
         );
     }
+    first_named
 }
 
 /// Where a panel's id may go, best first: its anchor, then points a third and two
-/// thirds of the way from it to the centre of each of its patches.
+/// thirds of the way from it to the centre of each of its patches, then those centres,
+/// then points halfway from each centre to its patch's corners.
 fn spots<'a>(
     anchor: DVec3,
     own: &'a [usize],
     patches: &'a [Patch],
 ) -> impl Iterator<Item = DVec3> + 'a {
-    let centres = own.iter().map(|&i| {
+    let centre = |i: usize| {
         let p = &patches[i].points;
         p.iter().copied().sum::<DVec3>() / p.len() as f64
-    });
+    };
+    let centres = own.iter().map(move |&i| centre(i));
     let near = centres.clone().map(move |c| anchor.lerp(c, 1.0 / 3.0));
-    let far = centres.map(move |c| anchor.lerp(c, 2.0 / 3.0));
-    std::iter::once(anchor).chain(near).chain(far)
+    let far = centres.clone().map(move |c| anchor.lerp(c, 2.0 / 3.0));
+    let toward_corners = own.iter().flat_map(move |&i| {
+        let c = centre(i);
+        patches[i].points.iter().map(move |&q| c.lerp(q, 0.5))
+    });
+    std::iter::once(anchor)
+        .chain(near)
+        .chain(far)
+        .chain(centres)
+        .chain(toward_corners)
 }
 
 /// A model point in a view's (right, up) coordinates (mm).
-fn project(p: DVec3, view: &View) -> DVec2 {
+pub(super) fn project(p: DVec3, view: &View) -> DVec2 {
     DVec2::new(p.dot(view.right()), p.dot(view.up))
 }
 
@@ -568,7 +752,7 @@ fn text_height(input: &MapInput, scale: f64) -> f64 {
 
 /// The sheets' tints (rows of numbered swatches) and the id key, along the page's
 /// foot.
-fn legend(out: &mut String, map: &MapContext, page: &Page, named: usize) {
+fn legend(out: &mut String, map: &MapContext, page: &Page, key: &str) {
     let input = map.input;
     let top = page.height - BORDER - page.legend_height();
     let _ = writeln!(out, "<g id=\"legend\">");
@@ -601,23 +785,44 @@ fn legend(out: &mut String, map: &MapContext, page: &Page, named: usize) {
     // The key at the size the page was laid out for (the text is never longer).
     let key = Lines {
         size: page.key.size,
-        lines: wrap(
-            &key_text(input.panels, named),
-            page.width - 2.0 * BORDER,
-            page.key.size,
-        ),
+        lines: wrap(key, page.width - 2.0 * BORDER, page.key.size),
     };
     let key_top = top + page.swatch_rows as f64 * SWATCH_ROW + GAP;
     text_lines(out, &key, DVec2::new(BORDER, key_top));
     out.push_str("</g>\n");
 }
 
-/// The legend's key: what the ids mean and how many panels are named.
-fn key_text(panels: &Panels, named: usize) -> String {
+/// The overview's key: what the ids mean and how many panels are named, here and, on
+/// a map of `pages` pages (0: one page), in the close-ups after it.
+fn key_text(panels: &Panels, [named, closer]: [usize; 2], pages: usize) -> String {
+    let ids = id_legend(panels);
+    let total = panels.len();
+    match pages {
+        0 => format!(
+            "Ids: {ids}. {named} of {total} panels named; one crowded out of a view is named in another."
+        ),
+        2 => format!(
+            "Ids: {ids}. {named} of {total} panels named here, {closer} more in the close-ups on page 2."
+        ),
+        _ => format!(
+            "Ids: {ids}. {named} of {total} panels named here, {closer} more in the close-ups on pages 2 to {pages}."
+        ),
+    }
+}
+
+/// The key of a page of close-ups.
+fn close_up_key(panels: &Panels) -> String {
     format!(
-        "Ids: {}. {named} of {} panels named; one crowded out of a view is named in another.",
-        id_legend(panels),
-        panels.len()
+        "Ids: {}. Each close-up shows the region around one panel larger, seen from the side its caption names, with the ids page 1 has no room for and, where there is room, their neighbours' ids; where the region is hidden, the model in front of it is cut away.",
+        id_legend(panels)
+    )
+}
+
+/// The title of page `page` of `pages`, a page of close-ups.
+fn close_up_title(input: &MapInput, page: usize, pages: usize) -> String {
+    format!(
+        "{}: assembly map, page {page} of {pages}: close-ups of the panels page 1 has no room to name",
+        input.name
     )
 }
 

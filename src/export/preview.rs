@@ -20,8 +20,8 @@ pub struct PreviewInput<'a> {
     pub manifest: &'a Manifest,
     /// Each sheet as an SVG document with visible strokes, in sheet order.
     pub sheets: &'a [String],
-    /// The assembly map's SVG document, if one was drawn.
-    pub map: Option<&'a str>,
+    /// The assembly map's pages as SVG documents (none if no map was drawn).
+    pub map: &'a [String],
 }
 
 /// The stroke width (mm) of a sheet on the preview page: a six-hundredth of the
@@ -62,11 +62,21 @@ pub fn preview_page(input: &PreviewInput) -> String {
         );
     }
     out.push_str("</div>\n");
-    if let Some(map) = input.map {
+    if !input.map.is_empty() {
+        out.push_str("<h2>Assembly map</h2>\n");
+    }
+    for (k, page) in input.map.iter().enumerate() {
+        let (id, alt) = match k {
+            0 => ("map".to_string(), "assembly map".to_string()),
+            _ => (
+                format!("map-{}", k + 1),
+                format!("assembly map, page {}", k + 1),
+            ),
+        };
         let _ = writeln!(
             out,
-            "<h2>Assembly map</h2>\n<figure id=\"map\"><img src=\"data:image/svg+xml;base64,{}\" alt=\"assembly map\"></figure>",
-            base64(map.as_bytes())
+            "<figure id=\"{id}\" class=\"map\"><img src=\"data:image/svg+xml;base64,{}\" alt=\"{alt}\"></figure>",
+            base64(page.as_bytes())
         );
     }
     out.push_str("</body>\n</html>\n");
@@ -82,7 +92,8 @@ th { color: #606060; }
 .sheets { display: flex; flex-wrap: wrap; gap: 24px; }
 figure { margin: 0; }
 figure img { display: block; width: 600px; max-width: 100%; height: auto; background: #FFFFFF; border: 1px solid #B0B0B0; }
-#map img { width: 900px; }
+.map img { width: 900px; }
+.map { margin-bottom: 24px; }
 figcaption { margin: 6px 0; }
 ";
 

@@ -50,6 +50,17 @@ pub fn shared_models(test: &str) -> Option<PathBuf> {
     }
 }
 
+/// The model files in the shared models' folder (OBJ and OFF), in name order.
+pub fn shared_model_files(shared: &Path) -> Vec<PathBuf> {
+    let mut models: Vec<PathBuf> = std::fs::read_dir(shared)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "obj" || x == "off"))
+        .collect();
+    models.sort();
+    models
+}
+
 // =======================================================================================
 // Running the binary
 // =======================================================================================
@@ -403,6 +414,18 @@ impl Sheets {
 /// Larger DXF files are read by the Rust reader only (unless `UNFOLD_FULL_DXF=1`).
 const EZDXF_MAX_BYTES: u64 = 1 << 20;
 
+/// Whether a file is a page of the assembly map (`NAME-map.svg`, `NAME-map-2.svg`…),
+/// a picture for people rather than a sheet.
+pub fn is_map_page(name: &str) -> bool {
+    let Some(stem) = name.strip_suffix(".svg") else {
+        return false;
+    };
+    stem.ends_with("-map")
+        || stem
+            .rsplit_once("-map-")
+            .is_some_and(|(_, k)| k.parse::<usize>().is_ok())
+}
+
 /// Checks every SVG of `out` with `check_svg_sheet` (sheet spec from the manifest) and
 /// the DXF files chosen by `dxf` against their SVG: each with the Rust reader, and with
 /// ezdxf as well those up to [`EZDXF_MAX_BYTES`] (at least the smallest one).
@@ -411,7 +434,7 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     let names = entry_names(out);
     // The sheets are the SVG and DXF files of the folder but the assembly map (a
     // picture for people, checked in tests/map.rs).
-    let is_map = |n: &String| n.ends_with("-map.svg");
+    let is_map = |n: &String| is_map_page(n);
     let svg_files: Vec<String> = names
         .iter()
         .filter(|n| n.ends_with(".svg") && !is_map(n))
@@ -539,6 +562,11 @@ pub fn check_output(
         format!("{name}-map.svg"),
         format!("{name}.html"),
     ]);
+    // The map's close-up pages, numbered from 2 on.
+    let map_pages = entry_names(out).iter().filter(|n| is_map_page(n)).count();
+    for k in 2..=map_pages {
+        expected.insert(format!("{name}-map-{k}.svg"));
+    }
     for k in 1..=sheets {
         expected.insert(format!("{name}-{k:0digits$}.svg"));
         expected.insert(format!("{name}-{k:0digits$}.dxf"));

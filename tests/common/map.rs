@@ -12,7 +12,29 @@ pub struct MapView {
     pub up: DVec3,
     pub scale: f64,
     pub origin: DVec2,
+    /// A close-up's cut: the depth along `toward` beyond which the model is cut away.
+    pub cut: Option<f64>,
     pub ids: Vec<(String, DVec2)>,
+}
+
+/// Every page of the map a build wrote (`NAME-map.svg`, then `NAME-map-2.svg`…), in
+/// page order, from the manifest's list of files.
+pub fn map_pages(out: &std::path::Path, files: &[&str]) -> Vec<String> {
+    let mut names: Vec<&str> = files
+        .iter()
+        .copied()
+        .filter(|n| super::build::is_map_page(n))
+        .collect();
+    let page = |n: &str| {
+        n.trim_end_matches(".svg")
+            .rsplit_once("-map-")
+            .map_or(1, |(_, k)| k.parse::<usize>().unwrap())
+    };
+    names.sort_by_key(|n| page(n));
+    names
+        .into_iter()
+        .map(|n| std::fs::read_to_string(out.join(n)).unwrap())
+        .collect()
 }
 
 pub fn attribute<'a>(tag: &'a str, name: &str) -> &'a str {
@@ -64,21 +86,30 @@ pub fn read_map(svg: &str) -> Vec<MapView> {
             up: vector(attribute(head, "data-up")),
             scale: attribute(head, "data-scale").parse().unwrap(),
             origin: DVec2::new(origin[0], origin[1]),
+            cut: head
+                .contains(" data-cut=\"")
+                .then(|| attribute(head, "data-cut").parse().unwrap()),
             ids,
         });
     }
     views
 }
 
-/// The face a ray from the viewer meets first, cast at a page point of a view.
+/// The face a ray from the viewer meets first, cast at a page point of a view; in a
+/// close-up cut open, from the cut on, past the back of a closed model's faces (its
+/// inside, which the map never draws).
 pub fn face_seen(mesh: &Mesh, view: &MapView, at: DVec2) -> Option<u32> {
     let right = (-view.toward).cross(view.up);
     let u = (at.x - view.origin.x) / view.scale;
     let v = -(at.y - view.origin.y) / view.scale;
-    let start = u * right + v * view.up + 1e7 * view.toward;
+    let start = u * right + v * view.up + view.cut.unwrap_or(1e7) * view.toward;
     let dir = -view.toward;
+    let closed = mesh.edges().all(|e| !mesh.is_boundary_edge(e));
     let mut best: Option<(f64, u32)> = None;
     for f in mesh.faces() {
+        if view.cut.is_some() && closed && mesh.face_normal(f).dot(view.toward) <= 1e-9 {
+            continue;
+        }
         let pts: Vec<DVec3> = mesh.face_positions(f).collect();
         for k in 1..pts.len() - 1 {
             if let Some(t) = ray_triangle(start, dir, pts[0], pts[k], pts[k + 1]) {
