@@ -12,6 +12,7 @@ pub mod ergs;
 pub mod half_edge;
 pub mod net;
 pub mod quad_edge;
+pub mod strip;
 pub mod winged_edge;
 pub mod woven;
 

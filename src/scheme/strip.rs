@@ -1,0 +1,1173 @@
+//! The geometry of developable strips: the level curves of a scalar field on a
+//! triangulated surface, the band of triangles between two neighbouring curves that
+//! bends least (every corner on one of the two curves, so no vertex is inside the
+//! band and it unrolls exactly; the dynamic programme of the strip paper, `003`), the
+//! band unrolled, and the distance between bands and the surface measured both ways.
+
+use std::collections::BTreeMap;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use crate::mesh::distance::TriangleGrid;
+use crate::mesh::Mesh;
+
+/// A surface as triangles over shared corners, counter-clockwise seen from outside.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Triangles {
+    pub points: Vec<DVec3>,
+    pub corners: Vec<[u32; 3]>,
+}
+
+impl Triangles {
+    /// The faces of `mesh`, each fanned from its first corner (the faces are convex).
+    pub fn from_mesh(mesh: &Mesh) -> Triangles {
+        let mut corners = Vec::new();
+        for f in mesh.faces() {
+            let ids: Vec<u32> = mesh.face_vertices(f).map(|v| v.0).collect();
+            for k in 1..ids.len().saturating_sub(1) {
+                corners.push([ids[0], ids[k], ids[k + 1]]);
+            }
+        }
+        Triangles {
+            points: mesh.positions().to_vec(),
+            corners,
+        }
+    }
+
+    /// The triangles by their corners' positions.
+    pub fn soup(&self) -> Vec<[DVec3; 3]> {
+        self.corners
+            .iter()
+            .map(|c| c.map(|i| self.points[i as usize]))
+            .collect()
+    }
+}
+
+/// A curve on the surface: a polyline, closed (its last point joins its first) or
+/// open (its ends on the surface's boundary).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    pub points: Vec<DVec3>,
+    pub closed: bool,
+}
+
+/// The curves where `field` (a value per point of `surface`, linear over each
+/// triangle) equals `level`, each running with the side above the level on its left
+/// seen from outside. A point exactly at the level counts as above, so every curve
+/// crosses edges between a point below and one above, never a corner.
+pub fn level_curves(surface: &Triangles, field: &[f64], level: f64) -> Vec<Curve> {
+    let above = |v: u32| field[v as usize] >= level;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    // In a counter-clockwise triangle, the curve runs from the edge leaving the lone
+    // corner above to the edge entering it (the corner on its left), and the other
+    // way round a lone corner below.
+    let mut next: BTreeMap<(u32, u32), (u32, u32)> = BTreeMap::new();
+    for &[a, b, c] in &surface.corners {
+        for (x, y, z) in [(a, b, c), (b, c, a), (c, a, b)] {
+            if above(x) != above(y) && above(x) != above(z) {
+                let (leaving, entering) = (key(x, y), key(z, x));
+                if above(x) {
+                    next.insert(leaving, entering);
+                } else {
+                    next.insert(entering, leaving);
+                }
+            }
+        }
+    }
+    let crossing = |(a, b): (u32, u32)| {
+        let (fa, fb) = (field[a as usize], field[b as usize]);
+        let t = ((level - fa) / (fb - fa)).clamp(0.0, 1.0);
+        surface.points[a as usize].lerp(surface.points[b as usize], t)
+    };
+    let entered: std::collections::BTreeSet<(u32, u32)> = next.values().copied().collect();
+    let mut done = std::collections::BTreeSet::new();
+    let mut curves = Vec::new();
+    // Open curves first, from the edge nothing enters, then the loops.
+    let starts: Vec<(u32, u32)> = next
+        .keys()
+        .filter(|k| !entered.contains(k))
+        .chain(next.keys())
+        .copied()
+        .collect();
+    for start in starts {
+        if done.contains(&start) {
+            continue;
+        }
+        let mut points = Vec::new();
+        let mut at = start;
+        let closed = loop {
+            done.insert(at);
+            points.push(crossing(at));
+            match next.get(&at) {
+                Some(&n) if n == start => break true,
+                Some(&n) if !done.contains(&n) => at = n,
+                Some(&n) => {
+                    // The end of an open curve on the boundary.
+                    done.insert(n);
+                    points.push(crossing(n));
+                    break false;
+                }
+                None => break false,
+            }
+        };
+        curves.push(Curve { points, closed });
+    }
+    curves
+}
+
+/// `curve` with the fewest points (Douglas–Peucker) that keep every dropped point
+/// within `tolerance` of the polyline kept; a loop keeps its first point and the
+/// point farthest from it.
+pub fn simplify(curve: &Curve, tolerance: f64) -> Curve {
+    let keep = kept_points(&curve.points, curve.closed, tolerance);
+    Curve {
+        points: curve
+            .points
+            .iter()
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+            .map(|(&q, _)| q)
+            .collect(),
+        closed: curve.closed,
+    }
+}
+
+/// Which of the polyline's points [`simplify`] keeps.
+fn kept_points(p: &[DVec3], closed: bool, tolerance: f64) -> Vec<bool> {
+    if p.len() < 3 {
+        return vec![true; p.len()];
+    }
+    let mut keep = vec![false; p.len()];
+    keep[0] = true;
+    if closed {
+        let far = (1..p.len())
+            .max_by(|&a, &b| p[a].distance(p[0]).total_cmp(&p[b].distance(p[0])))
+            .unwrap_or(1);
+        keep[far] = true;
+        keep_within(p, 0, far, tolerance, &mut keep);
+        // The second half, round to the first point again.
+        let mut round: Vec<DVec3> = p[far..].to_vec();
+        round.push(p[0]);
+        let mut kept = vec![false; round.len()];
+        keep_within(&round, 0, round.len() - 1, tolerance, &mut kept);
+        for (k, &flag) in kept.iter().enumerate().take(round.len() - 1) {
+            keep[far + k] |= flag;
+        }
+    } else {
+        let last = p.len() - 1;
+        keep[last] = true;
+        keep_within(p, 0, last, tolerance, &mut keep);
+    }
+    keep
+}
+
+/// Marks in `keep` the points between `from` and `to` that the polyline needs to stay
+/// within `tolerance` of every point of `p` there.
+fn keep_within(p: &[DVec3], from: usize, to: usize, tolerance: f64, keep: &mut [bool]) {
+    let mut spans = vec![(from, to)];
+    while let Some((a, b)) = spans.pop() {
+        let far = (a + 1..b)
+            .map(|k| (k, segment_distance(p[k], p[a], p[b])))
+            .max_by(|x, y| x.1.total_cmp(&y.1));
+        if let Some((k, d)) = far {
+            if d > tolerance {
+                keep[k] = true;
+                spans.push((a, k));
+                spans.push((k, b));
+            }
+        }
+    }
+}
+
+/// The distance from `p` to the segment `a`–`b`.
+fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + t * ab)
+}
+
+/// A band of triangles between two curves, each triangle sharing a rung (an edge from
+/// one curve to the other) with the next: its corners, those of the first curve
+/// first, and its triangles in order, counter-clockwise seen from outside.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Strip {
+    pub points: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// How much a rung's length counts against a radian of bending, per band width: a
+/// tie-break among bands that bend alike (a flat band bends nowhere), for the one of
+/// shorter rungs.
+const RUNG_WEIGHT: f64 = 1e-3;
+
+/// The band between the open polylines `p` (below, running with the band on its
+/// left) and `q` (above, running the same way), from rung `p[0]q[0]` to the last
+/// points' rung, that bends least: the dynamic programme over the triangles that
+/// advance along one curve or the other, the cost of each the angle between its
+/// normal and the previous triangle's.
+pub fn band(p: &[DVec3], q: &[DVec3]) -> Strip {
+    let (n, m) = (p.len(), q.len());
+    let points: Vec<DVec3> = p.iter().chain(q).copied().collect();
+    if n == 0 || m == 0 || n + m < 3 {
+        return Strip {
+            points,
+            triangles: Vec::new(),
+        };
+    }
+    let rungs = Rungs {
+        width: (p[0].distance(q[0]) + p[n - 1].distance(q[m - 1])).max(1e-12) * 0.5,
+        points: &points,
+        n,
+        m,
+    };
+    let cost = rungs.costs();
+    let triangles = rungs.trace_back(&cost);
+    Strip { points, triangles }
+}
+
+/// The grid of rungs (i, j) from point i of the lower curve to point j of the upper
+/// one, for the dynamic programme of [`band`].
+struct Rungs<'a> {
+    /// The lower curve's `n` points, then the upper curve's `m`.
+    points: &'a [DVec3],
+    n: usize,
+    m: usize,
+    /// The band's width at its ends, the unit of rung length.
+    width: f64,
+}
+
+impl Rungs<'_> {
+    /// The triangle reaching rung (i, j) from the previous rung: along the lower
+    /// curve (`k` = 0, advancing i) or the upper one (`k` = 1, advancing j).
+    fn triangle(&self, i: usize, j: usize, k: usize) -> [usize; 3] {
+        let n = self.n;
+        match k {
+            0 => [i - 1, i, n + j],
+            _ => [i, n + j, n + j - 1],
+        }
+    }
+
+    /// The rung before (i, j) on the way `k`, if there is one.
+    fn before(&self, i: usize, j: usize, k: usize) -> Option<(usize, usize)> {
+        match k {
+            0 => i.checked_sub(1).map(|i| (i, j)),
+            _ => j.checked_sub(1).map(|j| (i, j)),
+        }
+    }
+
+    fn normal(&self, t: [usize; 3]) -> DVec3 {
+        let p = self.points;
+        (p[t[1]] - p[t[0]])
+            .cross(p[t[2]] - p[t[0]])
+            .normalize_or_zero()
+    }
+
+    /// The bending between two triangles sharing a rung: the angle between their
+    /// normals (a half turn where one has no area).
+    fn bend(&self, a: [usize; 3], b: [usize; 3]) -> f64 {
+        let (x, y) = (self.normal(a), self.normal(b));
+        if x == DVec3::ZERO || y == DVec3::ZERO {
+            std::f64::consts::PI
+        } else {
+            x.dot(y).clamp(-1.0, 1.0).acos()
+        }
+    }
+
+    /// The cost of reaching rung (pi, pj) the way `h` and then going on with triangle
+    /// `next`: its cost so far and the bend between the two triangles.
+    fn through(
+        &self,
+        cost: &[[f64; 2]],
+        (pi, pj): (usize, usize),
+        h: usize,
+        next: [usize; 3],
+    ) -> f64 {
+        let so_far = cost[pi * self.m + pj][h];
+        if pi == 0 && pj == 0 {
+            so_far
+        } else {
+            so_far + self.bend(self.triangle(pi, pj, h), next)
+        }
+    }
+
+    /// `cost[i·m + j][k]`: the least cost of a band from rung (0, 0) to rung (i, j)
+    /// whose last triangle went the way `k`.
+    fn costs(&self) -> Vec<[f64; 2]> {
+        let (n, m) = (self.n, self.m);
+        let mut cost = vec![[f64::INFINITY; 2]; n * m];
+        cost[0] = [0.0, 0.0];
+        for i in 0..n {
+            for j in 0..m {
+                let length = self.points[i].distance(self.points[n + j]);
+                for k in 0..2 {
+                    let Some(from) = self.before(i, j, k) else {
+                        continue;
+                    };
+                    let next = self.triangle(i, j, k);
+                    let best = (0..2)
+                        .filter(|&h| cost[from.0 * m + from.1][h].is_finite())
+                        .map(|h| self.through(&cost, from, h, next))
+                        .fold(f64::INFINITY, f64::min);
+                    cost[i * m + j][k] = best + RUNG_WEIGHT * length / self.width;
+                }
+            }
+        }
+        cost
+    }
+
+    /// The band's triangles, in order: back from the last rung, each step the way
+    /// that gave the rung its cost.
+    fn trace_back(&self, cost: &[[f64; 2]]) -> Vec<[u32; 3]> {
+        let (mut i, mut j) = (self.n - 1, self.m - 1);
+        let last = cost[i * self.m + j];
+        let mut k = usize::from(last[1] < last[0]);
+        let mut triangles = Vec::with_capacity(self.n + self.m - 2);
+        while let Some(from) = self.before(i, j, k) {
+            let t = self.triangle(i, j, k);
+            triangles.push(t.map(|v| v as u32));
+            k = (0..2)
+                .filter(|&h| cost[from.0 * self.m + from.1][h].is_finite())
+                .min_by(|&a, &b| {
+                    let (x, y) = (
+                        self.through(cost, from, a, t),
+                        self.through(cost, from, b, t),
+                    );
+                    x.total_cmp(&y)
+                })
+                .unwrap_or(0);
+            (i, j) = from;
+        }
+        triangles.reverse();
+        triangles
+    }
+}
+
+/// The band between two loops, `p` below and `q` above, running the same way round:
+/// cut open at the rung from `p`'s first point to the nearest point of `q`, which
+/// then starts and ends both curves.
+pub fn ring(p: &[DVec3], q: &[DVec3]) -> Strip {
+    let Some(first) = p.first() else {
+        return band(p, q);
+    };
+    let start = (0..q.len())
+        .min_by(|&a, &b| q[a].distance(*first).total_cmp(&q[b].distance(*first)))
+        .unwrap_or(0);
+    let open_p: Vec<DVec3> = p.iter().chain([first]).copied().collect();
+    let open_q: Vec<DVec3> = q[start..]
+        .iter()
+        .chain(&q[..start])
+        .chain(q.get(start))
+        .copied()
+        .collect();
+    band(&open_p, &open_q)
+}
+
+/// The strip laid flat: a point per corner, each triangle placed against the rung it
+/// shares with the one before, counter-clockwise as seen from outside, so every edge
+/// keeps its length.
+pub fn unroll(strip: &Strip) -> Vec<DVec2> {
+    let mut flat: Vec<Option<DVec2>> = vec![None; strip.points.len()];
+    let length = |a: u32, b: u32| strip.points[a as usize].distance(strip.points[b as usize]);
+    for (n, t) in strip.triangles.iter().enumerate() {
+        if n == 0 {
+            let [a, b, _] = *t;
+            flat[a as usize] = Some(DVec2::ZERO);
+            flat[b as usize] = Some(DVec2::new(length(a, b), 0.0));
+        }
+        // Turn the triangle so that its corner not yet placed comes last.
+        let Some(r) = (0..3).find(|&r| flat[t[(r + 2) % 3] as usize].is_none()) else {
+            continue;
+        };
+        let [a, b, c] = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
+        let (Some(pa), Some(pb)) = (flat[a as usize], flat[b as usize]) else {
+            continue;
+        };
+        flat[c as usize] = Some(apex(pa, pb, length(a, c), length(b, c)));
+    }
+    flat.into_iter().map(Option::unwrap_or_default).collect()
+}
+
+/// The point at distances `ac` from `a` and `bc` from `b`, to the left of `a`→`b`.
+fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
+    let ab = b.distance(a);
+    if ab == 0.0 {
+        return a;
+    }
+    let along = (ac * ac - bc * bc + ab * ab) / (2.0 * ab);
+    let across = (ac * ac - along * along).max(0.0).sqrt();
+    let x = (b - a) / ab;
+    a + along * x + across * x.perp()
+}
+
+/// The largest distance from `from` to `to` (triangle sets), measured at points
+/// spread over `from`'s triangles no further than `spacing` apart.
+pub fn one_way_distance(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64) -> f64 {
+    let grid = TriangleGrid::new(to);
+    let mut worst: f64 = 0.0;
+    for t in from {
+        let longest = [
+            t[0].distance(t[1]),
+            t[1].distance(t[2]),
+            t[2].distance(t[0]),
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
+        let k = ((longest / spacing.max(1e-12)).ceil() as usize).clamp(1, 64);
+        for i in 0..=k {
+            for j in 0..=k - i {
+                let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
+                let point = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
+                worst = worst.max(grid.distance(point));
+            }
+        }
+    }
+    worst
+}
+
+/// The triangles of `strips` by their corners' positions.
+pub fn strip_soup(strips: &[Strip]) -> Vec<[DVec3; 3]> {
+    strips
+        .iter()
+        .flat_map(|s| s.triangles.iter().map(|t| t.map(|i| s.points[i as usize])))
+        .collect()
+}
+
+/// Where a point of the sliced surface comes from: a corner of the surface, or where
+/// a level crosses one of its edges (the edge by its corners, lower first).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Origin {
+    Corner(u32),
+    Crossing { edge: (u32, u32), level: u32 },
+}
+
+impl Origin {
+    /// Whether the point lies on the surface's edge `(a, b)` (lower first).
+    fn on_edge(&self, edge: (u32, u32)) -> bool {
+        match *self {
+            Origin::Corner(v) => v == edge.0 || v == edge.1,
+            Origin::Crossing { edge: e, .. } => e == edge,
+        }
+    }
+}
+
+/// The surface cut along the levels of a field: each triangle split into the convex
+/// pieces between neighbouring levels, the pieces' corners shared.
+pub struct Slices {
+    /// The levels, increasing; band `k` lies between `levels[k]` and `levels[k + 1]`.
+    pub levels: Vec<f64>,
+    points: Vec<DVec3>,
+    origins: Vec<Origin>,
+    /// Each piece: its band and its corners (indices into `points`), counter-clockwise.
+    pieces: Vec<(usize, Vec<u32>)>,
+}
+
+/// A region of one band: the pieces of the band joined across their shared edges.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    pub band: usize,
+    /// Its boundary loops, each with the region on its left seen from outside, as
+    /// indices into the slices' points.
+    pub loops: Vec<Vec<u32>>,
+    /// Its pieces' triangles (fans of the convex pieces), for measuring.
+    pub triangles: Vec<[DVec3; 3]>,
+}
+
+impl Slices {
+    /// `surface` cut along `levels` (increasing, none equal to a value of `field` at a
+    /// corner, so every cut crosses edges between their ends).
+    pub fn new(surface: &Triangles, field: &[f64], levels: Vec<f64>) -> Slices {
+        let mut slices = Slices {
+            levels,
+            points: Vec::new(),
+            origins: Vec::new(),
+            pieces: Vec::new(),
+        };
+        let mut ids: BTreeMap<Origin, u32> = BTreeMap::new();
+        for corners in &surface.corners {
+            // The triangle as (origin, value, position) corners.
+            let start: Vec<(Origin, f64, DVec3)> = corners
+                .iter()
+                .map(|&v| {
+                    (
+                        Origin::Corner(v),
+                        field[v as usize],
+                        surface.points[v as usize],
+                    )
+                })
+                .collect();
+            let lo = start.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+            let hi = start.iter().map(|c| c.1).fold(f64::NEG_INFINITY, f64::max);
+            for band in 0..slices.levels.len().saturating_sub(1) {
+                let (below, above) = (slices.levels[band], slices.levels[band + 1]);
+                if hi < below || lo > above {
+                    continue;
+                }
+                let piece = clip(
+                    &clip(&start, band as u32, below, true),
+                    band as u32 + 1,
+                    above,
+                    false,
+                );
+                if piece.len() < 3 {
+                    continue;
+                }
+                let corners = piece
+                    .iter()
+                    .map(|&(origin, _, position)| {
+                        *ids.entry(origin).or_insert_with(|| {
+                            slices.points.push(position);
+                            slices.origins.push(origin);
+                            slices.points.len() as u32 - 1
+                        })
+                    })
+                    .collect();
+                slices.pieces.push((band, corners));
+            }
+        }
+        slices
+    }
+
+    /// The position of point `id`.
+    pub fn point(&self, id: u32) -> DVec3 {
+        self.points[id as usize]
+    }
+
+    /// The level point `id` lies on, if it is a crossing.
+    pub fn level_of(&self, id: u32) -> Option<usize> {
+        match self.origins[id as usize] {
+            Origin::Crossing { level, .. } => Some(level as usize),
+            Origin::Corner(_) => None,
+        }
+    }
+
+    /// The regions: per band, its pieces joined across shared edges, in band order
+    /// and then by their first piece.
+    pub fn regions(&self) -> Vec<Region> {
+        let mut parent: Vec<usize> = (0..self.pieces.len()).collect();
+        fn root(parent: &mut [usize], mut i: usize) -> usize {
+            while parent[i] != i {
+                parent[i] = parent[parent[i]];
+                i = parent[i];
+            }
+            i
+        }
+        let mut first_by_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+        for (k, (band, corners)) in self.pieces.iter().enumerate() {
+            for (a, b) in cycle_pairs(corners) {
+                match first_by_edge.entry((a.min(b), a.max(b))) {
+                    std::collections::btree_map::Entry::Vacant(e) => {
+                        e.insert(k);
+                    }
+                    std::collections::btree_map::Entry::Occupied(e) => {
+                        let other = *e.get();
+                        if self.pieces[other].0 == *band {
+                            let (x, y) = (root(&mut parent, other), root(&mut parent, k));
+                            parent[x.max(y)] = x.min(y);
+                        }
+                    }
+                }
+            }
+        }
+        let mut members: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
+        for k in 0..self.pieces.len() {
+            let r = root(&mut parent, k);
+            members.entry((self.pieces[k].0, r)).or_default().push(k);
+        }
+        members
+            .into_iter()
+            .map(|((band, _), pieces)| self.region(band, &pieces))
+            .collect()
+    }
+
+    /// The region of `band` made of `pieces`: its boundary (the piece edges no other
+    /// of its pieces shares) chained into loops, and its triangles.
+    fn region(&self, band: usize, pieces: &[usize]) -> Region {
+        let mut directed: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+        for &k in pieces {
+            for (a, b) in cycle_pairs(&self.pieces[k].1) {
+                *directed.entry((a, b)).or_insert(0) += 1;
+            }
+        }
+        let mut next: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+        for &(a, b) in directed.keys() {
+            if !directed.contains_key(&(b, a)) {
+                next.entry(a).or_default().push(b);
+            }
+        }
+        let mut loops = Vec::new();
+        while let Some((&start, _)) = next.iter().find(|(_, to)| !to.is_empty()) {
+            let mut ring = vec![start];
+            let mut at = start;
+            while let Some(to) = next.get_mut(&at).and_then(|to| to.pop()) {
+                if to == start {
+                    break;
+                }
+                ring.push(to);
+                at = to;
+            }
+            loops.push(ring);
+        }
+        let triangles = pieces
+            .iter()
+            .flat_map(|&k| {
+                let c = &self.pieces[k].1;
+                (1..c.len() - 1).map(move |i| [c[0], c[i], c[i + 1]])
+            })
+            .map(|t| t.map(|i| self.point(i)))
+            .collect();
+        Region {
+            band,
+            loops,
+            triangles,
+        }
+    }
+}
+
+impl Slices {
+    /// Which points the strips keep: every corner of the surface, and of each level's
+    /// curves the fewest points within `tolerance` of them ([`simplify`]), the same
+    /// for the regions on either side of the curve.
+    pub fn kept(&self, tolerance: f64) -> Vec<bool> {
+        let mut keep: Vec<bool> = self
+            .origins
+            .iter()
+            .map(|o| matches!(o, Origin::Corner(_)))
+            .collect();
+        // Each level's curves, from the edges of the pieces above it that lie on it.
+        let mut next: BTreeMap<u32, u32> = BTreeMap::new();
+        for (band, corners) in &self.pieces {
+            for (a, b) in cycle_pairs(corners) {
+                if self.level_of(a) == Some(*band) && self.level_of(b) == Some(*band) {
+                    next.insert(a, b);
+                }
+            }
+        }
+        let entered: std::collections::BTreeSet<u32> = next.values().copied().collect();
+        let starts: Vec<u32> = next
+            .keys()
+            .filter(|k| !entered.contains(k))
+            .chain(next.keys())
+            .copied()
+            .collect();
+        let mut done = std::collections::BTreeSet::new();
+        for start in starts {
+            if done.contains(&start) {
+                continue;
+            }
+            let mut ids = vec![start];
+            done.insert(start);
+            let mut at = start;
+            let mut closed = false;
+            while let Some(&n) = next.get(&at) {
+                if n == start {
+                    closed = true;
+                    break;
+                }
+                if !done.insert(n) {
+                    break;
+                }
+                ids.push(n);
+                at = n;
+            }
+            let points: Vec<DVec3> = ids.iter().map(|&i| self.point(i)).collect();
+            for (&id, k) in ids.iter().zip(kept_points(&points, closed, tolerance)) {
+                keep[id as usize] |= k;
+            }
+        }
+        keep
+    }
+
+    /// The strip of `region`, its corners the points `kept`: between its two loops
+    /// (one on each level), or, for a region with one loop, between the run of that
+    /// loop on its lower level (or half of it) and the rest.
+    pub fn strip(&self, region: &Region, kept: &[bool]) -> Result<Strip, String> {
+        let loops: Vec<Vec<u32>> = region
+            .loops
+            .iter()
+            .map(|l| l.iter().copied().filter(|&i| kept[i as usize]).collect())
+            .collect();
+        let positions = |ids: &[u32]| ids.iter().map(|&i| self.point(i)).collect::<Vec<_>>();
+        let on = |ids: &[u32], level: usize| ids.iter().all(|&i| self.level_of(i) == Some(level));
+        match &loops[..] {
+            [one] => Ok(self.disk_strip(one, region.band)),
+            [a, b] if on(a, region.band) && on(b, region.band + 1) => {
+                Ok(ring(&positions(a), &positions_reversed(self, b)))
+            }
+            [a, b] if on(b, region.band) && on(a, region.band + 1) => {
+                Ok(ring(&positions(b), &positions_reversed(self, a)))
+            }
+            _ => Err(format!(
+                "a region between levels {} and {} has {} boundary loops",
+                region.band,
+                region.band + 1,
+                loops.len()
+            )),
+        }
+    }
+
+    /// The strip of a region bounded by one loop (region on its left): from the ends of
+    /// the loop's longest run on the lower level (or, on a loop with none or all of
+    /// it, from its first point to the point halfway round), one side against the other.
+    fn disk_strip(&self, ring_ids: &[u32], lower: usize) -> Strip {
+        let n = ring_ids.len();
+        let low = |k: usize| self.level_of(ring_ids[k % n]) == Some(lower);
+        // The longest cyclic run of lower-level points: its start and length.
+        let mut best = (0, 0);
+        for start in (0..n).filter(|&k| low(k) && !low(k + n - 1)) {
+            let length = (0..n).take_while(|&d| low(start + d)).count();
+            if length > best.1 {
+                best = (start, length);
+            }
+        }
+        let (start, end) = if best.1 >= 2 && best.1 < n {
+            (best.0, best.0 + best.1 - 1)
+        } else {
+            (0, n / 2)
+        };
+        let p: Vec<DVec3> = (start..=end).map(|k| self.point(ring_ids[k % n])).collect();
+        // The other side, from before `start` back round to after `end`.
+        let q: Vec<DVec3> = (1..n - (end - start))
+            .map(|d| self.point(ring_ids[(start + n - d) % n]))
+            .collect();
+        band(&p, &q)
+    }
+}
+
+/// Strips covering a surface, each band of the field's levels within the distance
+/// asked of the surface both ways.
+pub struct Banded {
+    pub slices: Slices,
+    pub regions: Vec<Region>,
+    /// A strip per region, in the regions' order.
+    pub strips: Vec<Strip>,
+    /// The largest distance measured between a strip and its region, either way.
+    pub deviation: f64,
+}
+
+/// How many times the bands are split before the bound is given up on.
+const MOST_ROUNDS: usize = 40;
+
+/// The strips of `surface` between levels of `field`, from one band over the whole
+/// field, each band whose strips stray more than `tolerance` from its regions (either
+/// way, measured at points `tolerance / 3` apart, allowing for the points between)
+/// split into equal bands, as many as should bring it within, until none strays.
+pub fn strips_within(surface: &Triangles, field: &[f64], tolerance: f64) -> Result<Banded, String> {
+    let mut values: Vec<f64> = field.to_vec();
+    values.sort_by(f64::total_cmp);
+    let (Some(&lo), Some(&hi)) = (values.first(), values.last()) else {
+        return Err("the surface has no points".into());
+    };
+    let span = (hi - lo).max(1e-9);
+    let mut levels = vec![lo - 1e-3 * span, hi + 1e-3 * span];
+    let spacing = tolerance / 3.0;
+    // Bands measured in earlier rounds (by their levels' bits): unchanged since.
+    let mut measured: BTreeMap<(u64, u64), f64> = BTreeMap::new();
+    for _ in 0..MOST_ROUNDS {
+        let slices = Slices::new(surface, field, levels.clone());
+        let kept = slices.kept(0.5 * tolerance);
+        let regions = slices.regions();
+        let mut worst = vec![0.0f64; levels.len() - 1];
+        let mut strips = Vec::with_capacity(regions.len());
+        // Each region measured on its own (in parallel; the results in region order).
+        let built: Vec<Result<(Strip, f64), String>> = regions
+            .par_iter()
+            .map(|region| {
+                let key = (
+                    levels[region.band].to_bits(),
+                    levels[region.band + 1].to_bits(),
+                );
+                let strip = slices.strip(region, &kept)?;
+                if measured.contains_key(&key) {
+                    return Ok((strip, 0.0));
+                }
+                let soup = strip_soup(std::slice::from_ref(&strip));
+                let out = one_way_distance(&soup, &region.triangles, spacing);
+                let back = one_way_distance(&region.triangles, &soup, spacing);
+                Ok((strip, out.max(back)))
+            })
+            .collect();
+        let mut why = vec![String::new(); worst.len()];
+        for (region, result) in regions.iter().zip(built) {
+            // A region no strip covers (the whole of a closed part, a saddle's) is
+            // split like one too far off.
+            let (strip, d) = result.unwrap_or_else(|e| {
+                why[region.band] = e;
+                let none = Strip {
+                    points: Vec::new(),
+                    triangles: Vec::new(),
+                };
+                (none, f64::INFINITY)
+            });
+            worst[region.band] = worst[region.band].max(d);
+            strips.push(strip);
+        }
+        for (b, d) in worst.iter_mut().enumerate() {
+            let key = (levels[b].to_bits(), levels[b + 1].to_bits());
+            *d = d.max(*measured.entry(key).or_insert(*d));
+        }
+        // Every point of a triangle lies within spacing/√3 of a sample.
+        let within = tolerance - spacing / 3f64.sqrt();
+        let wide: Vec<usize> = (0..worst.len()).filter(|&b| worst[b] > within).collect();
+        if wide.is_empty() {
+            let deviation = worst.iter().copied().fold(0.0, f64::max);
+            return Ok(Banded {
+                slices,
+                regions,
+                strips,
+                deviation,
+            });
+        }
+        for &b in wide.iter().rev() {
+            let (below, above) = (levels[b], levels[b + 1]);
+            if above - below < 1e-6 * span {
+                return Err(match worst[b].is_finite() {
+                    true => format!(
+                        "a band of the field {below}..{above} stays {:.3} mm from the surface",
+                        worst[b]
+                    ),
+                    false => why[b].clone(),
+                });
+            }
+            // A band's distance grows about as its width squared: split it into as
+            // many as should bring it within.
+            let parts = match worst[b].is_finite() {
+                true => ((worst[b] / within).sqrt().ceil() as usize).clamp(2, 8),
+                false => 4,
+            };
+            for k in (1..parts).rev() {
+                let t = k as f64 / parts as f64;
+                levels.insert(b + 1, off_values(below + t * (above - below), &values));
+            }
+        }
+    }
+    Err(format!(
+        "{MOST_ROUNDS} rounds of splitting bands did not reach {tolerance} mm"
+    ))
+}
+
+/// `level`, moved up past any value of the field exactly at it (a cut must cross
+/// edges between their ends, never at a corner).
+fn off_values(mut level: f64, sorted: &[f64]) -> f64 {
+    while sorted.binary_search_by(|v| v.total_cmp(&level)).is_ok() {
+        level = level.next_up();
+    }
+    level
+}
+
+/// The points of loop `ids`, last first.
+fn positions_reversed(slices: &Slices, ids: &[u32]) -> Vec<DVec3> {
+    ids.iter().rev().map(|&i| slices.point(i)).collect()
+}
+
+/// The consecutive pairs of a loop's corners, the last with the first.
+fn cycle_pairs(corners: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
+    corners
+        .iter()
+        .copied()
+        .zip(corners.iter().copied().cycle().skip(1))
+}
+
+/// The convex polygon `polygon` (corners with their field value) cut to the side of
+/// `value` (level number `level`) above it (`keep_above`) or below it; new corners are
+/// crossings of the surface's edges.
+fn clip(
+    polygon: &[(Origin, f64, DVec3)],
+    level: u32,
+    value: f64,
+    keep_above: bool,
+) -> Vec<(Origin, f64, DVec3)> {
+    let inside = |f: f64| if keep_above { f > value } else { f < value };
+    let mut out = Vec::with_capacity(polygon.len() + 2);
+    for (k, &a) in polygon.iter().enumerate() {
+        let b = polygon[(k + 1) % polygon.len()];
+        if inside(a.1) {
+            out.push(a);
+        }
+        if inside(a.1) != inside(b.1) {
+            let edge = surface_edge(a.0, b.0);
+            let t = (value - a.1) / (b.1 - a.1);
+            out.push((Origin::Crossing { edge, level }, value, a.2.lerp(b.2, t)));
+        }
+    }
+    out
+}
+
+/// The surface edge both points lie on: a cut crosses only edges of the triangle
+/// (a level's own cut is never crossed by another level).
+fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
+    let ends = |o: Origin| match o {
+        Origin::Corner(v) => [v, v],
+        Origin::Crossing { edge, .. } => [edge.0, edge.1],
+    };
+    let candidates = ends(a).into_iter().chain(ends(b));
+    let mut best = (0, 0);
+    for x in candidates.clone() {
+        for y in candidates.clone() {
+            let edge = (x.min(y), x.max(y));
+            if x != y && a.on_edge(edge) && b.on_edge(edge) {
+                best = edge;
+            }
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::TAU;
+
+    /// A tube of `around` × `along` quads split into triangles, radius `r(h)` at
+    /// height `h` in 0..=height, open at both ends (a cylinder or a cone).
+    fn tube(around: usize, along: usize, height: f64, r: impl Fn(f64) -> f64) -> Triangles {
+        let mut points = Vec::new();
+        for k in 0..=along {
+            let h = height * k as f64 / along as f64;
+            for i in 0..around {
+                let a = TAU * i as f64 / around as f64;
+                points.push(DVec3::new(r(h) * a.cos(), r(h) * a.sin(), h));
+            }
+        }
+        let id = |k: usize, i: usize| (k * around + i % around) as u32;
+        let mut corners = Vec::new();
+        for k in 0..along {
+            for i in 0..around {
+                // Counter-clockwise seen from outside (normals away from the axis).
+                corners.push([id(k, i), id(k, i + 1), id(k + 1, i + 1)]);
+                corners.push([id(k, i), id(k + 1, i + 1), id(k + 1, i)]);
+            }
+        }
+        Triangles { points, corners }
+    }
+
+    fn heights(surface: &Triangles) -> Vec<f64> {
+        surface.points.iter().map(|p| p.z).collect()
+    }
+
+    /// The edges used by one triangle only: the strip's outline.
+    fn outline_edges(strip: &Strip) -> BTreeMap<(u32, u32), usize> {
+        let mut uses = BTreeMap::new();
+        for t in &strip.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        uses.retain(|_, n| *n == 1);
+        uses
+    }
+
+    #[test]
+    fn a_level_of_a_tube_is_one_loop_round_it_with_the_top_on_its_left() {
+        let tube = tube(24, 4, 100.0, |_| 50.0);
+        let curves = level_curves(&tube, &heights(&tube), 37.5);
+        assert_eq!(curves.len(), 1);
+        let loop_ = &curves[0];
+        assert!(loop_.closed);
+        assert_eq!(loop_.points.len(), 48, "one point per crossed edge");
+        for p in &loop_.points {
+            assert!((p.z - 37.5).abs() < 1e-9);
+        }
+        // Running counter-clockwise seen from above (+z): the top on its left seen
+        // from outside.
+        let turn: f64 = loop_
+            .points
+            .iter()
+            .zip(loop_.points.iter().cycle().skip(1))
+            .map(|(a, b)| a.x * b.y - a.y * b.x)
+            .sum();
+        assert!(turn > 0.0, "{turn}");
+    }
+
+    #[test]
+    fn a_level_across_an_open_tube_is_two_curves_from_rim_to_rim() {
+        let tube = tube(24, 4, 100.0, |_| 50.0);
+        let across: Vec<f64> = tube.points.iter().map(|p| p.x).collect();
+        let curves = level_curves(&tube, &across, 10.0);
+        assert_eq!(curves.len(), 2, "{curves:?}");
+        for c in &curves {
+            assert!(!c.closed);
+            let ends = [c.points[0].z, c.points[c.points.len() - 1].z];
+            assert!(ends == [0.0, 100.0] || ends == [100.0, 0.0], "{ends:?}");
+            assert!(c.points.iter().all(|p| (p.x - 10.0).abs() < 1e-9));
+        }
+    }
+
+    #[test]
+    fn simplifying_keeps_every_point_within_the_tolerance() {
+        let tube = tube(64, 1, 10.0, |_| 100.0);
+        let loop_ = &level_curves(&tube, &heights(&tube), 5.0)[0];
+        let coarse = simplify(loop_, 2.0);
+        assert!(
+            coarse.points.len() < loop_.points.len() / 2,
+            "{}",
+            coarse.points.len()
+        );
+        let n = coarse.points.len();
+        for p in &loop_.points {
+            let d = (0..n)
+                .map(|k| segment_distance(*p, coarse.points[k], coarse.points[(k + 1) % n]))
+                .fold(f64::INFINITY, f64::min);
+            assert!(d <= 2.0 + 1e-9, "{d}");
+        }
+    }
+
+    #[test]
+    fn the_band_between_a_cylinders_rims_is_its_surface_and_unrolls_to_its_rectangle() {
+        let around = 16;
+        let tube = tube(around, 1, 80.0, |_| 30.0);
+        let rims: Vec<Vec<DVec3>> = [0.0, 80.0]
+            .iter()
+            .map(|&h| tube.points.iter().copied().filter(|p| p.z == h).collect())
+            .collect();
+        let strip = ring(&rims[0], &rims[1]);
+        assert_eq!(strip.triangles.len(), 2 * around);
+        // Every corner on the outline: no vertex inside the band.
+        let outline = outline_edges(&strip);
+        for v in strip.triangles.iter().flatten() {
+            assert!(
+                outline.keys().any(|&(a, b)| a == *v || b == *v),
+                "{v} inside"
+            );
+        }
+        // The band is the tube itself, both ways.
+        let (band_soup, tube_soup) = (strip_soup(std::slice::from_ref(&strip)), tube.soup());
+        assert!(one_way_distance(&band_soup, &tube_soup, 1.0) < 1e-9);
+        assert!(one_way_distance(&tube_soup, &band_soup, 1.0) < 1e-9);
+        // Unrolled, every edge keeps its length, and the band is a rectangle as long as
+        // the rim's polygon.
+        let flat = unroll(&strip);
+        for t in &strip.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                let d3 = strip.points[a].distance(strip.points[b]);
+                assert!((flat[a].distance(flat[b]) - d3).abs() < 1e-9 * 80.0);
+            }
+        }
+        // The rim below (the first around + 1 corners, its first point again at the
+        // end) lies on one line as long as the rim's polygon, the rim above on the line
+        // parallel to it 80 mm away.
+        let side = 2.0 * 30.0 * (std::f64::consts::PI / around as f64).sin();
+        let (start, end) = (flat[0], flat[around]);
+        assert!((start.distance(end) - around as f64 * side).abs() < 1e-9);
+        let along = (end - start).normalize();
+        for (k, p) in flat.iter().enumerate() {
+            let off = along.perp_dot(*p - start);
+            let expected = if k <= around { 0.0 } else { 80.0 };
+            assert!((off - expected).abs() < 1e-9, "corner {k}: {off}");
+        }
+    }
+
+    #[test]
+    fn a_band_between_straight_lines_in_a_plane_does_not_bend() {
+        let p: Vec<DVec3> = (0..5)
+            .map(|i| DVec3::new(i as f64 * 10.0, 0.0, 0.0))
+            .collect();
+        let q: Vec<DVec3> = (0..8)
+            .map(|i| DVec3::new(i as f64 * 6.0, 20.0, 0.0))
+            .collect();
+        let strip = band(&p, &q);
+        assert_eq!(strip.triangles.len(), p.len() + q.len() - 2);
+        for t in &strip.triangles {
+            let [a, b, c] = t.map(|i| strip.points[i as usize]);
+            let normal = (b - a).cross(c - a);
+            assert!(normal.z > 0.0, "counter-clockwise: {normal}");
+        }
+    }
+
+    /// A sphere of `radius` from a `around` × `rings` grid of latitudes, a point at
+    /// each pole.
+    fn sphere(radius: f64, around: usize, rings: usize) -> Triangles {
+        let mut points = vec![DVec3::new(0.0, 0.0, -radius)];
+        for k in 1..rings {
+            let lat = std::f64::consts::PI * (k as f64 / rings as f64 - 0.5);
+            for i in 0..around {
+                let a = TAU * i as f64 / around as f64;
+                points
+                    .push(radius * DVec3::new(lat.cos() * a.cos(), lat.cos() * a.sin(), lat.sin()));
+            }
+        }
+        points.push(DVec3::new(0.0, 0.0, radius));
+        let top = points.len() as u32 - 1;
+        let id = |k: usize, i: usize| (1 + (k - 1) * around + i % around) as u32;
+        let mut corners = Vec::new();
+        for i in 0..around {
+            corners.push([0, id(1, i + 1), id(1, i)]);
+            corners.push([top, id(rings - 1, i), id(rings - 1, i + 1)]);
+        }
+        for k in 1..rings - 1 {
+            for i in 0..around {
+                corners.push([id(k, i), id(k, i + 1), id(k + 1, i + 1)]);
+                corners.push([id(k, i), id(k + 1, i + 1), id(k + 1, i)]);
+            }
+        }
+        Triangles { points, corners }
+    }
+
+    #[test]
+    fn strips_of_a_sphere_stay_within_the_bound_unroll_exactly_and_share_their_curves() {
+        let sphere = sphere(100.0, 48, 24);
+        // A field along a tilted axis: its levels cross the grid's edges anywhere.
+        let axis = DVec3::new(0.3, 0.2, 0.93).normalize();
+        let field: Vec<f64> = sphere.points.iter().map(|p| p.dot(axis)).collect();
+        let tolerance = 2.0;
+        let clock = std::time::Instant::now();
+        let banded = strips_within(&sphere, &field, tolerance).unwrap();
+        eprintln!(
+            "{} strips, {} levels, deviation {:.3} in {:?}",
+            banded.strips.len(),
+            banded.slices.levels.len(),
+            banded.deviation,
+            clock.elapsed()
+        );
+        assert!(banded.strips.len() >= 3, "{}", banded.strips.len());
+        // Within the bound both ways, measured again far more finely over the whole.
+        let soup = strip_soup(&banded.strips);
+        let whole = sphere.soup();
+        let out = one_way_distance(&soup, &whole, tolerance / 10.0);
+        let back = one_way_distance(&whole, &soup, tolerance / 10.0);
+        assert!(out <= tolerance && back <= tolerance, "{out} {back}");
+        for strip in &banded.strips {
+            // No corner inside a strip: every one on its outline.
+            let outline = outline_edges(strip);
+            for v in strip.triangles.iter().flatten() {
+                assert!(
+                    outline.keys().any(|&(a, b)| a == *v || b == *v),
+                    "{v} inside"
+                );
+            }
+            let flat = unroll(strip);
+            for t in &strip.triangles {
+                for k in 0..3 {
+                    let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
+                    let d3 = strip.points[a].distance(strip.points[b]);
+                    assert!((flat[a].distance(flat[b]) - d3).abs() < 1e-9 * 100.0);
+                }
+            }
+        }
+        // The strips on either side of a level meet at the same points on it.
+        let levels = &banded.slices.levels;
+        for (j, &level) in levels.iter().enumerate().skip(1).take(levels.len() - 2) {
+            let on_level = |band: usize| {
+                let mut at: Vec<[i64; 3]> = banded
+                    .regions
+                    .iter()
+                    .zip(&banded.strips)
+                    .filter(|(r, _)| r.band == band)
+                    .flat_map(|(_, s)| s.points.iter())
+                    .filter(|p| (p.dot(axis) - level).abs() < 1e-9)
+                    .map(|p| (*p * 1e6).round().as_i64vec3().to_array())
+                    .collect();
+                at.sort();
+                at.dedup();
+                at
+            };
+            assert_eq!(on_level(j - 1), on_level(j), "level {j}");
+        }
+    }
+}
