@@ -200,10 +200,11 @@ pub struct Strip {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// How much a rung's length counts against a radian of bending, per band width: a
-/// tie-break among bands that bend alike (a flat band bends nowhere), for the one of
-/// shorter rungs.
-const RUNG_WEIGHT: f64 = 1e-3;
+/// How much a rung's length counts against a radian of bending, per band width: the
+/// rungs go across the band, not along it (in a narrow band a triangle's normal says
+/// little about the surface, and bending alone would fan far along it), and among
+/// bands that bend alike (a flat band bends nowhere) the one of shorter rungs wins.
+const RUNG_WEIGHT: f64 = 0.25;
 
 /// The band between the open polylines `p` (below, running with the band on its
 /// left) and `q` (above, running the same way), from rung `p[0]q[0]` to the last
@@ -219,8 +220,18 @@ pub fn band(p: &[DVec3], q: &[DVec3]) -> Strip {
             triangles: Vec::new(),
         };
     }
+    // The band's width: how far, on average, a point of one curve is from the other.
+    let width = p
+        .iter()
+        .map(|a| {
+            q.iter()
+                .map(|b| a.distance(*b))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum::<f64>()
+        / n as f64;
     let rungs = Rungs {
-        width: (p[0].distance(q[0]) + p[n - 1].distance(q[m - 1])).max(1e-12) * 0.5,
+        width: width.max(1e-12),
         points: &points,
         n,
         m,
@@ -237,7 +248,7 @@ struct Rungs<'a> {
     points: &'a [DVec3],
     n: usize,
     m: usize,
-    /// The band's width at its ends, the unit of rung length.
+    /// The band's mean width, the unit of rung length.
     width: f64,
 }
 
@@ -475,6 +486,8 @@ pub struct Region {
     pub loops: Vec<Vec<u32>>,
     /// Its pieces' triangles (fans of the convex pieces), for measuring.
     pub triangles: Vec<[DVec3; 3]>,
+    /// Its pieces, as indices into the slices'.
+    pieces: Vec<usize>,
 }
 
 impl Slices {
@@ -624,6 +637,7 @@ impl Slices {
             band,
             loops,
             triangles,
+            pieces: pieces.to_vec(),
         }
     }
 }
@@ -693,21 +707,99 @@ impl Slices {
             .collect();
         let positions = |ids: &[u32]| ids.iter().map(|&i| self.point(i)).collect::<Vec<_>>();
         let on = |ids: &[u32], level: usize| ids.iter().all(|&i| self.level_of(i) == Some(level));
-        match &loops[..] {
-            [one] => Ok(self.disk_strip(one, region.band)),
-            [a, b] if on(a, region.band) && on(b, region.band + 1) => {
-                Ok(ring(&positions(a), &positions_reversed(self, b)))
-            }
-            [a, b] if on(b, region.band) && on(a, region.band + 1) => {
-                Ok(ring(&positions(b), &positions_reversed(self, a)))
-            }
-            _ => Err(format!(
-                "a region between levels {} and {} has {} boundary loops",
+        let lower: Vec<Vec<u32>> = loops
+            .iter()
+            .filter(|l| on(l, region.band))
+            .cloned()
+            .collect();
+        let upper: Vec<Vec<u32>> = loops
+            .iter()
+            .filter(|l| on(l, region.band + 1))
+            .cloned()
+            .collect();
+        let unjoined = || {
+            format!(
+                "the {} boundary loops of a region between levels {} and {} are not joined \
+                 by its pieces",
+                loops.len(),
                 region.band,
-                region.band + 1,
-                loops.len()
-            )),
+                region.band + 1
+            )
+        };
+        if loops.is_empty() {
+            return Err(format!(
+                "a region between levels {} and {} has no boundary (a closed part)",
+                region.band,
+                region.band + 1
+            ));
         }
+        if !lower.is_empty() && !upper.is_empty() && lower.len() + upper.len() == loops.len() {
+            // Loops on both levels (a saddle's region has two on one of them): the
+            // loops of each level joined into one through the region, and the band
+            // between the two.
+            let below = self.bridged(region, &lower, kept).ok_or_else(unjoined)?;
+            let above = self.bridged(region, &upper, kept).ok_or_else(unjoined)?;
+            return Ok(ring(&positions(&below), &positions_reversed(self, &above)));
+        }
+        let one = self.bridged(region, &loops, kept).ok_or_else(unjoined)?;
+        Ok(self.disk_strip(&one, region.band))
+    }
+
+    /// The loops of `region` joined into one by bridges (the region then a disk, its
+    /// bridges slits run out and back): each time the shortest path through the
+    /// region's pieces from the loop joined so far to another loop, through corners
+    /// inside the region and the loops' kept points only (so that a neighbouring
+    /// region meets the same points).
+    fn bridged(&self, region: &Region, loops: &[Vec<u32>], kept: &[bool]) -> Option<Vec<u32>> {
+        let mut loop_of: BTreeMap<u32, usize> = BTreeMap::new();
+        for (k, l) in loops.iter().enumerate() {
+            for &i in l {
+                loop_of.insert(i, k);
+            }
+        }
+        let boundary: std::collections::BTreeSet<u32> =
+            region.loops.iter().flatten().copied().collect();
+        let allowed =
+            |i: u32| loop_of.contains_key(&i) || (!boundary.contains(&i) && kept[i as usize]);
+        // Every two allowed corners of a convex piece see each other inside it.
+        let mut links: BTreeMap<u32, Vec<(u32, f64)>> = BTreeMap::new();
+        for &k in &region.pieces {
+            let corners: Vec<u32> = self.pieces[k]
+                .1
+                .iter()
+                .copied()
+                .filter(|&i| allowed(i))
+                .collect();
+            for &a in &corners {
+                for &b in &corners {
+                    if a != b {
+                        links
+                            .entry(a)
+                            .or_default()
+                            .push((b, self.point(a).distance(self.point(b))));
+                    }
+                }
+            }
+        }
+        let mut merged = loops.first()?.clone();
+        let mut joined = vec![false; loops.len()];
+        joined[0] = true;
+        while joined.iter().any(|j| !j) {
+            let (path, other) = shortest_bridge(&merged, &links, |i| {
+                loop_of.get(&i).copied().filter(|&k| !joined[k])
+            })?;
+            joined[other] = true;
+            let (from, to) = (path[0], path[path.len() - 1]);
+            let at = merged.iter().position(|&i| i == from)?;
+            let target = &loops[other];
+            let start = target.iter().position(|&i| i == to)?;
+            // Out along the bridge, round the other loop, back along the bridge.
+            let mut insert: Vec<u32> = path[1..].to_vec();
+            insert.extend(target[start + 1..].iter().chain(&target[..start]));
+            insert.extend(path.iter().rev());
+            merged.splice(at + 1..at + 1, insert);
+        }
+        Some(merged)
     }
 
     /// The strip of a region bounded by one loop (region on its left): from the ends of
@@ -765,60 +857,27 @@ pub fn strips_within(surface: &Triangles, field: &[f64], tolerance: f64) -> Resu
     let span = (hi - lo).max(1e-9);
     let mut levels = vec![lo - 1e-3 * span, hi + 1e-3 * span];
     let spacing = tolerance / 3.0;
+    // Every point of a triangle lies within spacing/√3 of a sample.
+    let within = tolerance - spacing / 3f64.sqrt();
     // Bands measured in earlier rounds (by their levels' bits): unchanged since.
     let mut measured: BTreeMap<(u64, u64), f64> = BTreeMap::new();
     for _ in 0..MOST_ROUNDS {
         let slices = Slices::new(surface, field, levels.clone());
         let kept = slices.kept(0.5 * tolerance);
         let regions = slices.regions();
-        let mut worst = vec![0.0f64; levels.len() - 1];
-        let mut strips = Vec::with_capacity(regions.len());
-        // Each region measured on its own (in parallel; the results in region order).
-        let built: Vec<Result<(Strip, f64), String>> = regions
-            .par_iter()
-            .map(|region| {
-                let key = (
-                    levels[region.band].to_bits(),
-                    levels[region.band + 1].to_bits(),
-                );
-                let strip = slices.strip(region, &kept)?;
-                if measured.contains_key(&key) {
-                    return Ok((strip, 0.0));
-                }
-                let soup = strip_soup(std::slice::from_ref(&strip));
-                let out = one_way_distance(&soup, &region.triangles, spacing);
-                let back = one_way_distance(&region.triangles, &soup, spacing);
-                Ok((strip, out.max(back)))
-            })
-            .collect();
-        let mut why = vec![String::new(); worst.len()];
-        for (region, result) in regions.iter().zip(built) {
-            // A region no strip covers (the whole of a closed part, a saddle's) is
-            // split like one too far off.
-            let (strip, d) = result.unwrap_or_else(|e| {
-                why[region.band] = e;
-                let none = Strip {
-                    points: Vec::new(),
-                    triangles: Vec::new(),
-                };
-                (none, f64::INFINITY)
-            });
-            worst[region.band] = worst[region.band].max(d);
-            strips.push(strip);
-        }
+        let round = measure(&slices, &regions, &kept, &measured, spacing);
+        let mut worst = round.worst;
         for (b, d) in worst.iter_mut().enumerate() {
             let key = (levels[b].to_bits(), levels[b + 1].to_bits());
             *d = d.max(*measured.entry(key).or_insert(*d));
         }
-        // Every point of a triangle lies within spacing/√3 of a sample.
-        let within = tolerance - spacing / 3f64.sqrt();
         let wide: Vec<usize> = (0..worst.len()).filter(|&b| worst[b] > within).collect();
         if wide.is_empty() {
             let deviation = worst.iter().copied().fold(0.0, f64::max);
             return Ok(Banded {
                 slices,
                 regions,
-                strips,
+                strips: round.strips,
                 deviation,
             });
         }
@@ -830,7 +889,7 @@ pub fn strips_within(surface: &Triangles, field: &[f64], tolerance: f64) -> Resu
                         "a band of the field {below}..{above} stays {:.3} mm from the surface",
                         worst[b]
                     ),
-                    false => why[b].clone(),
+                    false => round.why[b].clone(),
                 });
             }
             // A band's distance grows about as its width squared: split it into as
@@ -850,6 +909,65 @@ pub fn strips_within(surface: &Triangles, field: &[f64], tolerance: f64) -> Resu
     ))
 }
 
+/// One round of [`strips_within`]: a strip per region and, per band, the largest
+/// distance between its strips and regions (none measured for a band in `measured`;
+/// infinite, with the reason, where a region has no strip).
+struct Round {
+    strips: Vec<Strip>,
+    worst: Vec<f64>,
+    why: Vec<String>,
+}
+
+/// The strips of `regions` and their distances, each region on its own (in parallel;
+/// the results in region order).
+fn measure(
+    slices: &Slices,
+    regions: &[Region],
+    kept: &[bool],
+    measured: &BTreeMap<(u64, u64), f64>,
+    spacing: f64,
+) -> Round {
+    let levels = &slices.levels;
+    let built: Vec<Result<(Strip, f64), String>> = regions
+        .par_iter()
+        .map(|region| {
+            let key = (
+                levels[region.band].to_bits(),
+                levels[region.band + 1].to_bits(),
+            );
+            let strip = slices.strip(region, kept)?;
+            if measured.contains_key(&key) {
+                return Ok((strip, 0.0));
+            }
+            let soup = strip_soup(std::slice::from_ref(&strip));
+            let out = one_way_distance(&soup, &region.triangles, spacing);
+            let back = one_way_distance(&region.triangles, &soup, spacing);
+            Ok((strip, out.max(back)))
+        })
+        .collect();
+    let bands = levels.len() - 1;
+    let mut round = Round {
+        strips: Vec::with_capacity(regions.len()),
+        worst: vec![0.0; bands],
+        why: vec![String::new(); bands],
+    };
+    for (region, result) in regions.iter().zip(built) {
+        // A region no strip covers (the whole of a closed part) is split like one too
+        // far off.
+        let (strip, d) = result.unwrap_or_else(|e| {
+            round.why[region.band] = e;
+            let none = Strip {
+                points: Vec::new(),
+                triangles: Vec::new(),
+            };
+            (none, f64::INFINITY)
+        });
+        round.worst[region.band] = round.worst[region.band].max(d);
+        round.strips.push(strip);
+    }
+    round
+}
+
 /// `level`, moved up past any value of the field exactly at it (a cut must cross
 /// edges between their ends, never at a corner).
 fn off_values(mut level: f64, sorted: &[f64]) -> f64 {
@@ -857,6 +975,64 @@ fn off_values(mut level: f64, sorted: &[f64]) -> f64 {
         level = level.next_up();
     }
     level
+}
+
+/// The shortest path along `links` from any point of `from` to a point `target`
+/// names a loop for, with that loop.
+fn shortest_bridge(
+    from: &[u32],
+    links: &BTreeMap<u32, Vec<(u32, f64)>>,
+    target: impl Fn(u32) -> Option<usize>,
+) -> Option<(Vec<u32>, usize)> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let mut best: BTreeMap<u32, (f64, Option<u32>)> = BTreeMap::new();
+    let mut queue = BinaryHeap::new();
+    for &i in from {
+        best.insert(i, (0.0, None));
+        queue.push(Reverse((Distance(0.0), i)));
+    }
+    while let Some(Reverse((Distance(d), i))) = queue.pop() {
+        if best.get(&i).is_some_and(|&(b, _)| d > b) {
+            continue;
+        }
+        if let Some(other) = target(i) {
+            let mut path = vec![i];
+            let mut at = i;
+            while let Some(&(_, Some(previous))) = best.get(&at) {
+                path.push(previous);
+                at = previous;
+            }
+            path.reverse();
+            return Some((path, other));
+        }
+        for &(j, length) in links.get(&i).into_iter().flatten() {
+            let through = d + length;
+            if best.get(&j).is_none_or(|&(b, _)| through < b) {
+                best.insert(j, (through, Some(i)));
+                queue.push(Reverse((Distance(through), j)));
+            }
+        }
+    }
+    None
+}
+
+/// A path length ordered totally, for the search's queue.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Distance(f64);
+
+impl Eq for Distance {}
+
+impl PartialOrd for Distance {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Distance {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
 }
 
 /// The points of loop `ids`, last first.
@@ -1109,15 +1285,15 @@ mod tests {
         Triangles { points, corners }
     }
 
-    #[test]
-    fn strips_of_a_sphere_stay_within_the_bound_unroll_exactly_and_share_their_curves() {
-        let sphere = sphere(100.0, 48, 24);
-        // A field along a tilted axis: its levels cross the grid's edges anywhere.
-        let axis = DVec3::new(0.3, 0.2, 0.93).normalize();
-        let field: Vec<f64> = sphere.points.iter().map(|p| p.dot(axis)).collect();
-        let tolerance = 2.0;
+    /// Strips of `surface` along `axis` within `tolerance`: within it both ways
+    /// (measured again more finely over the whole), every corner on a strip's outline,
+    /// edge lengths kept unrolled, the strips on either side of each level meeting at
+    /// the same points. Returns how many strips.
+    fn check_strips(surface: &Triangles, axis: DVec3, tolerance: f64) -> usize {
+        let axis = axis.normalize();
+        let field: Vec<f64> = surface.points.iter().map(|p| p.dot(axis)).collect();
         let clock = std::time::Instant::now();
-        let banded = strips_within(&sphere, &field, tolerance).unwrap();
+        let banded = strips_within(surface, &field, tolerance).unwrap();
         eprintln!(
             "{} strips, {} levels, deviation {:.3} in {:?}",
             banded.strips.len(),
@@ -1125,15 +1301,13 @@ mod tests {
             banded.deviation,
             clock.elapsed()
         );
-        assert!(banded.strips.len() >= 3, "{}", banded.strips.len());
-        // Within the bound both ways, measured again far more finely over the whole.
         let soup = strip_soup(&banded.strips);
-        let whole = sphere.soup();
+        let whole = surface.soup();
         let out = one_way_distance(&soup, &whole, tolerance / 10.0);
         let back = one_way_distance(&whole, &soup, tolerance / 10.0);
         assert!(out <= tolerance && back <= tolerance, "{out} {back}");
+        let size = extent_of(&surface.points);
         for strip in &banded.strips {
-            // No corner inside a strip: every one on its outline.
             let outline = outline_edges(strip);
             for v in strip.triangles.iter().flatten() {
                 assert!(
@@ -1146,11 +1320,10 @@ mod tests {
                 for k in 0..3 {
                     let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
                     let d3 = strip.points[a].distance(strip.points[b]);
-                    assert!((flat[a].distance(flat[b]) - d3).abs() < 1e-9 * 100.0);
+                    assert!((flat[a].distance(flat[b]) - d3).abs() < 1e-9 * size);
                 }
             }
         }
-        // The strips on either side of a level meet at the same points on it.
         let levels = &banded.slices.levels;
         for (j, &level) in levels.iter().enumerate().skip(1).take(levels.len() - 2) {
             let on_level = |band: usize| {
@@ -1169,5 +1342,48 @@ mod tests {
             };
             assert_eq!(on_level(j - 1), on_level(j), "level {j}");
         }
+        banded.strips.len()
+    }
+
+    fn extent_of(points: &[DVec3]) -> f64 {
+        let lo = points.iter().copied().fold(DVec3::INFINITY, DVec3::min);
+        let hi = points.iter().copied().fold(DVec3::NEG_INFINITY, DVec3::max);
+        lo.distance(hi)
+    }
+
+    #[test]
+    fn strips_of_a_sphere_stay_within_the_bound_unroll_exactly_and_share_their_curves() {
+        // A field along a tilted axis: its levels cross the grid's edges anywhere.
+        let strips = check_strips(&sphere(100.0, 48, 24), DVec3::new(0.3, 0.2, 0.93), 2.0);
+        assert!(strips >= 3, "{strips}");
+    }
+
+    /// A torus about the z axis: `around` × `across` quads split into triangles.
+    fn torus(big: f64, small: f64, around: usize, across: usize) -> Triangles {
+        let mut points = Vec::new();
+        for i in 0..around {
+            let a = TAU * i as f64 / around as f64;
+            for j in 0..across {
+                let b = TAU * j as f64 / across as f64;
+                let r = big + small * b.cos();
+                points.push(DVec3::new(r * a.cos(), r * a.sin(), small * b.sin()));
+            }
+        }
+        let id = |i: usize, j: usize| ((i % around) * across + j % across) as u32;
+        let mut corners = Vec::new();
+        for i in 0..around {
+            for j in 0..across {
+                corners.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                corners.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        Triangles { points, corners }
+    }
+
+    #[test]
+    fn strips_of_a_torus_bridge_its_saddles() {
+        // Along an axis in its plane the field has two saddles, where a band's
+        // region has three loops.
+        check_strips(&torus(100.0, 40.0, 48, 24), DVec3::new(1.0, 0.2, 0.1), 2.0);
     }
 }
