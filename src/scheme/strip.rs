@@ -145,6 +145,14 @@ fn kept_points(p: &[DVec3], closed: bool, tolerance: f64) -> Vec<bool> {
             .max_by(|&a, &b| p[a].distance(p[0]).total_cmp(&p[b].distance(p[0])))
             .unwrap_or(1);
         keep[far] = true;
+        // And the point farthest from those two, so that a loop keeps an area.
+        let third = (1..p.len()).filter(|&k| k != far).max_by(|&a, &b| {
+            let d = |k: usize| segment_distance(p[k], p[0], p[far]);
+            d(a).total_cmp(&d(b))
+        });
+        if let Some(third) = third {
+            keep[third] = true;
+        }
         keep_within(p, 0, far, tolerance, &mut keep);
         // The second half, round to the first point again.
         let mut round: Vec<DVec3> = p[far..].to_vec();
@@ -747,9 +755,9 @@ impl Slices {
 
     /// The loops of `region` joined into one by bridges (the region then a disk, its
     /// bridges slits run out and back): each time the shortest path through the
-    /// region's pieces from the loop joined so far to another loop, through corners
-    /// inside the region and the loops' kept points only (so that a neighbouring
-    /// region meets the same points).
+    /// region's pieces from the loop joined so far to another loop, keeping of its
+    /// corners those inside the region and the loops' kept points only (so that a
+    /// neighbouring region meets the same points on their curve).
     fn bridged(&self, region: &Region, loops: &[Vec<u32>], kept: &[bool]) -> Option<Vec<u32>> {
         let mut loop_of: BTreeMap<u32, usize> = BTreeMap::new();
         for (k, l) in loops.iter().enumerate() {
@@ -759,19 +767,16 @@ impl Slices {
         }
         let boundary: std::collections::BTreeSet<u32> =
             region.loops.iter().flatten().copied().collect();
-        let allowed =
+        // A bridge keeps the corners inside the region and the loops' kept points; it
+        // passes the others of the boundary by.
+        let stays =
             |i: u32| loop_of.contains_key(&i) || (!boundary.contains(&i) && kept[i as usize]);
-        // Every two allowed corners of a convex piece see each other inside it.
+        // Every two corners of a convex piece see each other inside it.
         let mut links: BTreeMap<u32, Vec<(u32, f64)>> = BTreeMap::new();
         for &k in &region.pieces {
-            let corners: Vec<u32> = self.pieces[k]
-                .1
-                .iter()
-                .copied()
-                .filter(|&i| allowed(i))
-                .collect();
-            for &a in &corners {
-                for &b in &corners {
+            let corners = &self.pieces[k].1;
+            for &a in corners {
+                for &b in corners {
                     if a != b {
                         links
                             .entry(a)
@@ -789,6 +794,7 @@ impl Slices {
                 loop_of.get(&i).copied().filter(|&k| !joined[k])
             })?;
             joined[other] = true;
+            let path: Vec<u32> = path.into_iter().filter(|&i| stays(i)).collect();
             let (from, to) = (path[0], path[path.len() - 1]);
             let at = merged.iter().position(|&i| i == from)?;
             let target = &loops[other];
@@ -936,6 +942,13 @@ fn measure(
                 levels[region.band + 1].to_bits(),
             );
             let strip = slices.strip(region, kept)?;
+            if strip.triangles.is_empty() {
+                return Err(format!(
+                    "a region between levels {} and {} is too small for a triangle",
+                    region.band,
+                    region.band + 1
+                ));
+            }
             if measured.contains_key(&key) {
                 return Ok((strip, 0.0));
             }
