@@ -94,6 +94,9 @@ const RASTER_PER_MM: f64 = 4.0;
 const TEXT_MIN: f64 = 1.8;
 const TEXT_MAX: f64 = 3.0;
 
+/// The fill of a closed model's inside where a close-up cuts it open.
+const INSIDE: &str = "#D0D0D0";
+
 /// The page's outer border (mm).
 const BORDER: f64 = 8.0;
 
@@ -140,10 +143,12 @@ pub fn assembly_map(input: &MapInput) -> Vec<String> {
         .iter()
         .map(|v| bounds(patches.iter().flat_map(|p| &p.points), v))
         .collect();
+    let all = input.panels.len();
     let page = Page::new(
         input,
         &title_text(input),
-        &key_text(input.panels, [input.panels.len(); 2], input.panels.len()),
+        &key_text(input.panels, [all, all, all], all + 1),
+        true,
     );
     let grid = Grid::largest(&page, &views, &extents);
     let map = MapContext {
@@ -164,12 +169,13 @@ pub fn assembly_map(input: &MapInput) -> Vec<String> {
     let count = |named: &[bool]| named.iter().filter(|&&n| n).count();
     let on_overview = count(&named);
     let close_ups = close_up_pages(&map, &mut named);
-    let pages = match close_ups.len() {
-        0 => 0,
-        more => more + 1,
-    };
     let closer = count(&named) - on_overview;
-    let key = key_text(input.panels, [on_overview, closer], pages);
+    let unnamed = input.panels.len() - count(&named);
+    let key = key_text(
+        input.panels,
+        [on_overview, closer, unnamed],
+        close_ups.len() + 1,
+    );
     legend(&mut out, &map, &page, &key);
     out.push_str("</svg>\n");
     std::iter::once(out).chain(close_ups).collect()
@@ -183,15 +189,22 @@ fn close_up_pages(map: &MapContext, named: &mut [bool]) -> Vec<String> {
     }
     let input = map.input;
     let key = close_up_key(input.panels);
-    let page = Page::new(input, &close_up_title(input, 99, 99), &key);
+    // Laid out for the longest title a page can have.
+    let most = input.panels.len() + 1;
+    let page = Page::new(input, &close_up_title(input, most, most), &key, false);
     let cells = CloseUpCells::new(&page);
+    if cells.cell.min_element() < CLOSE_UP_CELL_LEAST {
+        // The paper has no room for a close-up (the legend takes it): the key says
+        // how many panels are left unnamed.
+        return Vec::new();
+    }
     let drawn = super::map_closeup::close_ups(map, &cells, named);
     let count = drawn.len().div_ceil(cells.per_page());
     drawn
         .chunks(cells.per_page())
         .enumerate()
         .map(|(k, chunk)| {
-            let page = Page::new(input, &close_up_title(input, k + 2, count + 1), &key);
+            let page = page.retitled(&close_up_title(input, k + 2, count + 1));
             let mut out = String::new();
             page_head(&mut out, &page);
             for cell in chunk {
@@ -216,6 +229,9 @@ pub(super) struct CloseUpCells {
 /// The smallest side (mm) of a close-up's cell, paper allowing: room for a region of
 /// a few panels around the one it shows.
 const CLOSE_UP_CELL: f64 = 80.0;
+
+/// The least side (mm) of a close-up's cell: below it, none is drawn.
+const CLOSE_UP_CELL_LEAST: f64 = 30.0;
 
 impl CloseUpCells {
     fn new(page: &Page) -> CloseUpCells {
@@ -255,8 +271,9 @@ struct Page {
 }
 
 impl Page {
-    /// The page for `input` with `title`, and room for `key` (or any shorter text).
-    fn new(input: &MapInput, title: &str, key: &str) -> Page {
+    /// The page for `input` with `title`, and room for `key` (or any shorter text)
+    /// and, if `swatches`, a swatch per sheet.
+    fn new(input: &MapInput, title: &str, key: &str, swatches: bool) -> Page {
         let (width, height) = page_size(input);
         let text_w = width - 2.0 * BORDER;
         let title = fit(title, text_w, TITLE_TEXT[0], TITLE_TEXT[1], 2);
@@ -270,8 +287,25 @@ impl Page {
             height,
             title,
             swatches_per_row,
-            swatch_rows: sheets.div_ceil(swatches_per_row),
+            swatch_rows: if swatches {
+                sheets.div_ceil(swatches_per_row)
+            } else {
+                0
+            },
             key,
+        }
+    }
+
+    /// This page with `title` (no longer than the one it was laid out for) at the
+    /// size it was laid out for.
+    fn retitled(&self, title: &str) -> Page {
+        Page {
+            title: Lines {
+                size: self.title.size,
+                lines: wrap(title, self.width - 2.0 * BORDER, self.title.size),
+            },
+            key: self.key.clone(),
+            ..*self
         }
     }
 
@@ -464,6 +498,7 @@ fn draw_view(
         scale,
         area: (cell_lo, DVec2::new(grid.cell_w, grid.cell_h)),
         contain: false,
+        cut_open: false,
     };
     let _ = writeln!(
         out,
@@ -488,6 +523,9 @@ pub(super) struct Frame<'a> {
     pub area: (DVec2, DVec2),
     /// Ids must lie wholly inside `area` (a close-up's drawing runs past it).
     pub contain: bool,
+    /// The model in front is cut away (a close-up's), so a closed model's inside
+    /// shows.
+    pub cut_open: bool,
 }
 
 impl Frame<'_> {
@@ -522,13 +560,17 @@ pub(super) fn draw_frame(
     first: Option<usize>,
 ) -> bool {
     let to_page = |p: DVec3| frame.to_page(p);
-    let order = far_to_near(patches, map.input.surface.closed, frame.view);
-    draw_patches(out, map, patches, &order, frame.view, &to_page);
+    let closed = map.input.surface.closed;
+    // A closed model cut open shows its inside: the backs of its faces, drawn grey,
+    // hide what lies behind them and name no panel.
+    let inside = |p: &Patch| closed && frame.cut_open && p.normal.dot(frame.view.toward) <= 1e-9;
+    let order = far_to_near(patches, closed && !frame.cut_open, frame.view);
+    draw_patches(out, map, patches, &order, frame.view, &to_page, &inside);
     if let Some(first) = first {
         outline(out, patches, &order, first, &to_page);
     }
     let raster = Raster::new(frame.area.0, frame.area.1);
-    let owners = raster.owners(patches, &order, frame.view, &to_page);
+    let owners = raster.owners(patches, &order, frame.view, &to_page, &inside);
     let seen = SeenPanels {
         raster: &raster,
         owners: &owners,
@@ -564,11 +606,16 @@ fn draw_patches(
     order: &[(f64, usize)],
     view: &View,
     to_page: &dyn Fn(DVec3) -> DVec2,
+    inside: &dyn Fn(&Patch) -> bool,
 ) {
     for &(_, i) in order {
         let patch = &patches[i];
         let facing = patch.normal.dot(view.toward);
-        let fill = map.palette.colour(map.sheet_of[patch.panel], facing);
+        let fill = if inside(patch) {
+            INSIDE.to_string()
+        } else {
+            map.palette.colour(map.sheet_of[patch.panel], facing)
+        };
         let mut d = String::new();
         for (j, &p) in patch.points.iter().enumerate() {
             let q = to_page(p);
@@ -757,17 +804,24 @@ fn legend(out: &mut String, map: &MapContext, page: &Page, key: &str) {
     let top = page.height - BORDER - page.legend_height();
     let _ = writeln!(out, "<g id=\"legend\">");
     let size = LEGEND_TEXT[0];
-    let _ = writeln!(
-        out,
-        "<text x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>",
-        fmt_mm(BORDER),
-        fmt_mm(top + 3.5),
-        fmt_mm(size),
-        SHEETS_WORD.trim_end()
-    );
+    if page.swatch_rows > 0 {
+        let _ = writeln!(
+            out,
+            "<text x=\"{}\" y=\"{}\" font-size=\"{}\">{}</text>",
+            fmt_mm(BORDER),
+            fmt_mm(top + 3.5),
+            fmt_mm(size),
+            SHEETS_WORD.trim_end()
+        );
+    }
     let entry = swatch_width(input.layout.sheets.max(1));
     let first_x = BORDER + text_width(SHEETS_WORD, size);
-    for sheet in 0..input.layout.sheets {
+    let swatches = if page.swatch_rows > 0 {
+        input.layout.sheets
+    } else {
+        0
+    };
+    for sheet in 0..swatches {
         let (row, col) = (sheet / page.swatches_per_row, sheet % page.swatches_per_row);
         let (x, y) = (first_x + col as f64 * entry, top + row as f64 * SWATCH_ROW);
         let _ = writeln!(
@@ -792,20 +846,23 @@ fn legend(out: &mut String, map: &MapContext, page: &Page, key: &str) {
     out.push_str("</g>\n");
 }
 
-/// The overview's key: what the ids mean and how many panels are named, here and, on
-/// a map of `pages` pages (0: one page), in the close-ups after it.
-fn key_text(panels: &Panels, [named, closer]: [usize; 2], pages: usize) -> String {
+/// The overview's key: what the ids mean and how many panels are named here, in the
+/// close-ups on the map's later pages (`pages` in all), and not at all.
+fn key_text(panels: &Panels, [named, closer, unnamed]: [usize; 3], pages: usize) -> String {
     let ids = id_legend(panels);
     let total = panels.len();
-    match pages {
-        0 => format!(
+    let later = match pages {
+        0 | 1 => String::new(),
+        2 => format!(", {closer} more in the close-ups on page 2"),
+        _ => format!(", {closer} more in the close-ups on pages 2 to {pages}"),
+    };
+    match unnamed {
+        0 if pages <= 1 => format!(
             "Ids: {ids}. {named} of {total} panels named; one crowded out of a view is named in another."
         ),
-        2 => format!(
-            "Ids: {ids}. {named} of {total} panels named here, {closer} more in the close-ups on page 2."
-        ),
+        0 => format!("Ids: {ids}. {named} of {total} panels named here{later}."),
         _ => format!(
-            "Ids: {ids}. {named} of {total} panels named here, {closer} more in the close-ups on pages 2 to {pages}."
+            "Ids: {ids}. {named} of {total} panels named here{later}; {unnamed} not named: this paper has no room for their close-ups (a larger --sheet has)."
         ),
     }
 }
@@ -813,7 +870,7 @@ fn key_text(panels: &Panels, [named, closer]: [usize; 2], pages: usize) -> Strin
 /// The key of a page of close-ups.
 fn close_up_key(panels: &Panels) -> String {
     format!(
-        "Ids: {}. Each close-up shows the region around one panel larger, seen from the side its caption names, with the ids page 1 has no room for and, where there is room, their neighbours' ids; where the region is hidden, the model in front of it is cut away.",
+        "Ids: {}. Each close-up shows the region around one panel (outlined) larger, seen from the side its caption names, with the ids page 1 cannot show and, where there is room, their neighbours' ids; where the region is hidden, the model in front of it is cut away. Tints as on page 1.",
         id_legend(panels)
     )
 }
@@ -821,7 +878,7 @@ fn close_up_key(panels: &Panels) -> String {
 /// The title of page `page` of `pages`, a page of close-ups.
 fn close_up_title(input: &MapInput, page: usize, pages: usize) -> String {
     format!(
-        "{}: assembly map, page {page} of {pages}: close-ups of the panels page 1 has no room to name",
+        "{}: assembly map, page {page} of {pages}: close-ups of the panels page 1 cannot name",
         input.name
     )
 }
@@ -880,23 +937,20 @@ impl Raster {
         order: &[(f64, usize)],
         view: &View,
         to_page: &dyn Fn(DVec3) -> DVec2,
+        inside: &dyn Fn(&Patch) -> bool,
     ) -> Vec<Option<u32>> {
         let mut owner = vec![None; self.width * self.height];
         let mut depth = vec![f64::NEG_INFINITY; self.width * self.height];
         for &(_, i) in order {
             let patch = &patches[i];
+            let id = (!inside(patch)).then_some(patch.panel as u32);
             let pts: Vec<(DVec2, f64)> = patch
                 .points
                 .iter()
                 .map(|&p| ((to_page(p) - self.lo) * RASTER_PER_MM, p.dot(view.toward)))
                 .collect();
             for k in 1..pts.len().saturating_sub(1) {
-                self.triangle(
-                    [pts[0], pts[k], pts[k + 1]],
-                    patch.panel as u32,
-                    &mut owner,
-                    &mut depth,
-                );
+                self.triangle([pts[0], pts[k], pts[k + 1]], id, &mut owner, &mut depth);
             }
         }
         owner
@@ -905,7 +959,7 @@ impl Raster {
     fn triangle(
         &self,
         t: [(DVec2, f64); 3],
-        id: u32,
+        id: Option<u32>,
         owner: &mut [Option<u32>],
         depth: &mut [f64],
     ) {
@@ -931,7 +985,7 @@ impl Raster {
                 let cell = y * self.width + x;
                 if z >= depth[cell] {
                     depth[cell] = z;
-                    owner[cell] = Some(id);
+                    owner[cell] = id;
                 }
             }
         }

@@ -19,6 +19,10 @@ use crate::panel::surface::Patch;
 /// The least a close-up enlarges on the overview.
 const CLOSER: f64 = 1.25;
 
+/// The most the first enlargement exceeds what the panel's room asks (a panel seen
+/// nearly edge on would ask for far more).
+const MOST_ENLARGED: f64 = 8.0;
+
 /// Enlargements tried in turn when a panel's id finds no room at the first.
 const ZOOMS: [f64; 4] = [1.0, 1.6, 2.6, 4.2];
 
@@ -83,9 +87,25 @@ fn close_up(
         cut_sight(&own, normal, size),
         cut_sight(&own, roomiest.normal, size),
     ];
+    let model_front = |toward: DVec3| {
+        patches
+            .iter()
+            .flat_map(|p| &p.points)
+            .map(|q| q.dot(toward))
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let mut tried: Vec<(DVec3, Option<f64>)> = Vec::new();
     for (toward, cut) in sights {
+        // A cut in front of the whole model cuts nothing away.
+        let cut = cut.filter(|&c| c < model_front(toward));
+        if tried.contains(&(toward, cut)) {
+            continue;
+        }
+        tried.push((toward, cut));
         let view = view_toward(toward);
-        let first = first_scale(map, &own, &view, &id).max(fits);
+        let first = first_scale(map, &own, &view, &id)
+            .max(fits)
+            .min(MOST_ENLARGED * fits.max(CLOSER * map.grid.scale));
         for zoom in ZOOMS {
             let shot = Shot {
                 k,
@@ -143,6 +163,7 @@ impl Shot<'_> {
             scale: self.scale,
             area,
             contain: true,
+            cut_open: self.cut.is_some(),
         };
         let patches = self.patches(map, &frame);
         let mut trial = named.to_vec();
@@ -206,19 +227,20 @@ impl Shot<'_> {
     /// whose page box meets the drawing.
     fn patches(&self, map: &MapContext, frame: &Frame) -> Vec<Patch> {
         let (lo, hi) = (frame.area.0, frame.area.0 + frame.area.1);
+        // Cutting only shrinks a patch: those whose whole box misses go first.
         map.input
             .surface
             .patches
             .iter()
-            .filter_map(|p| match self.cut {
-                Some(cut) => cut_away(p, self.view.toward, cut),
-                None => Some(p.clone()),
-            })
             .filter(|p| {
                 let page: Vec<DVec2> = p.points.iter().map(|&q| frame.to_page(q)).collect();
                 let a = page.iter().copied().fold(DVec2::INFINITY, DVec2::min);
                 let b = page.iter().copied().fold(DVec2::NEG_INFINITY, DVec2::max);
                 a.x < hi.x && lo.x < b.x && a.y < hi.y && lo.y < b.y
+            })
+            .filter_map(|p| match self.cut {
+                Some(cut) => cut_away(p, self.view.toward, cut),
+                None => Some(p.clone()),
             })
             .collect()
     }
@@ -370,6 +392,11 @@ fn cut_away(p: &Patch, toward: DVec3, cut: f64) -> Option<Patch> {
         if (da <= 0.0) != (db <= 0.0) {
             points.push(a + (b - a) * (da / (da - db)));
         }
+    }
+    // A corner on the cut is met twice: once itself, once as where an edge crosses.
+    points.dedup();
+    if points.len() > 1 && points.first() == points.last() {
+        points.pop();
     }
     (points.len() >= 3).then_some(Patch {
         points,

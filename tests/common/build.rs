@@ -414,16 +414,25 @@ impl Sheets {
 /// Larger DXF files are read by the Rust reader only (unless `UNFOLD_FULL_DXF=1`).
 const EZDXF_MAX_BYTES: u64 = 1 << 20;
 
-/// Whether a file is a page of the assembly map (`NAME-map.svg`, `NAME-map-2.svg`…),
-/// a picture for people rather than a sheet.
-pub fn is_map_page(name: &str) -> bool {
-    let Some(stem) = name.strip_suffix(".svg") else {
-        return false;
-    };
-    stem.ends_with("-map")
-        || stem
-            .rsplit_once("-map-")
-            .is_some_and(|(_, k)| k.parse::<usize>().is_ok())
+/// The model's name the files of a build start with: that of its assembled model.
+pub fn model_stem<S: AsRef<str>>(files: &[S]) -> String {
+    files
+        .iter()
+        .find_map(|n| n.as_ref().strip_suffix("-assembled.obj"))
+        .expect("an assembled model among the files")
+        .to_string()
+}
+
+/// The page number of a page of the assembly map of the model `stem`
+/// (`STEM-map.svg` is 1, `STEM-map-2.svg` 2…), or `None` for any other file.
+pub fn map_page_number(stem: &str, name: &str) -> Option<usize> {
+    let rest = name.strip_prefix(stem)?.strip_suffix(".svg")?;
+    if rest == "-map" {
+        return Some(1);
+    }
+    let k = rest.strip_prefix("-map-")?;
+    let digits = !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit());
+    digits.then(|| k.parse().ok()).flatten().filter(|&k| k >= 2)
 }
 
 /// Checks every SVG of `out` with `check_svg_sheet` (sheet spec from the manifest) and
@@ -434,7 +443,8 @@ pub fn check_sheets(out: &Path, manifest: &Value, dxf: DxfCheck) -> Sheets {
     let names = entry_names(out);
     // The sheets are the SVG and DXF files of the folder but the assembly map (a
     // picture for people, checked in tests/map.rs).
-    let is_map = |n: &String| is_map_page(n);
+    let stem = model_stem(&names.iter().collect::<Vec<_>>());
+    let is_map = |n: &String| map_page_number(&stem, n).is_some();
     let svg_files: Vec<String> = names
         .iter()
         .filter(|n| n.ends_with(".svg") && !is_map(n))
@@ -563,7 +573,10 @@ pub fn check_output(
         format!("{name}.html"),
     ]);
     // The map's close-up pages, numbered from 2 on.
-    let map_pages = entry_names(out).iter().filter(|n| is_map_page(n)).count();
+    let map_pages = entry_names(out)
+        .iter()
+        .filter(|n| map_page_number(&name, n).is_some())
+        .count();
     for k in 2..=map_pages {
         expected.insert(format!("{name}-map-{k}.svg"));
     }

@@ -3,7 +3,7 @@
 //! the model at a page point names the face seen there.
 
 use glam::{DVec2, DVec3};
-use unfold::mesh::Mesh;
+use unfold::mesh::{FaceId, Mesh};
 
 /// One view of the map: its projection and the ids written in it.
 pub struct MapView {
@@ -20,17 +20,13 @@ pub struct MapView {
 /// Every page of the map a build wrote (`NAME-map.svg`, then `NAME-map-2.svg`…), in
 /// page order, from the manifest's list of files.
 pub fn map_pages(out: &std::path::Path, files: &[&str]) -> Vec<String> {
-    let mut names: Vec<&str> = files
+    let stem = super::build::model_stem(files);
+    let mut names: Vec<(usize, &str)> = files
         .iter()
-        .copied()
-        .filter(|n| super::build::is_map_page(n))
+        .filter_map(|n| super::build::map_page_number(&stem, n).map(|k| (k, *n)))
         .collect();
-    let page = |n: &str| {
-        n.trim_end_matches(".svg")
-            .rsplit_once("-map-")
-            .map_or(1, |(_, k)| k.parse::<usize>().unwrap())
-    };
-    names.sort_by_key(|n| page(n));
+    names.sort();
+    let names: Vec<&str> = names.into_iter().map(|(_, n)| n).collect();
     names
         .into_iter()
         .map(|n| std::fs::read_to_string(out.join(n)).unwrap())
@@ -96,20 +92,16 @@ pub fn read_map(svg: &str) -> Vec<MapView> {
 }
 
 /// The face a ray from the viewer meets first, cast at a page point of a view; in a
-/// close-up cut open, from the cut on, past the back of a closed model's faces (its
-/// inside, which the map never draws).
+/// close-up cut open, from the cut on, and none where it meets the back of a closed
+/// model's face first (its inside, which names no panel).
 pub fn face_seen(mesh: &Mesh, view: &MapView, at: DVec2) -> Option<u32> {
     let right = (-view.toward).cross(view.up);
     let u = (at.x - view.origin.x) / view.scale;
     let v = -(at.y - view.origin.y) / view.scale;
     let start = u * right + v * view.up + view.cut.unwrap_or(1e7) * view.toward;
     let dir = -view.toward;
-    let closed = mesh.edges().all(|e| !mesh.is_boundary_edge(e));
     let mut best: Option<(f64, u32)> = None;
     for f in mesh.faces() {
-        if view.cut.is_some() && closed && mesh.face_normal(f).dot(view.toward) <= 1e-9 {
-            continue;
-        }
         let pts: Vec<DVec3> = mesh.face_positions(f).collect();
         for k in 1..pts.len() - 1 {
             if let Some(t) = ray_triangle(start, dir, pts[0], pts[k], pts[k + 1]) {
@@ -119,7 +111,10 @@ pub fn face_seen(mesh: &Mesh, view: &MapView, at: DVec2) -> Option<u32> {
             }
         }
     }
-    best.map(|(_, f)| f)
+    let closed = mesh.edges().all(|e| !mesh.is_boundary_edge(e));
+    best.map(|(_, f)| f).filter(|&f| {
+        !(view.cut.is_some() && closed && mesh.face_normal(FaceId(f)).dot(view.toward) <= 1e-9)
+    })
 }
 
 /// Möller–Trumbore: the distance along the ray to the triangle, if it meets it.
