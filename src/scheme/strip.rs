@@ -481,6 +481,8 @@ pub struct Slices {
     pub levels: Vec<f64>,
     points: Vec<DVec3>,
     origins: Vec<Origin>,
+    /// The field's value at each point.
+    values: Vec<f64>,
     /// Each piece: its band and its corners (indices into `points`), counter-clockwise.
     pieces: Vec<(usize, Vec<u32>)>,
 }
@@ -506,6 +508,7 @@ impl Slices {
             levels,
             points: Vec::new(),
             origins: Vec::new(),
+            values: Vec::new(),
             pieces: Vec::new(),
         };
         let mut ids: BTreeMap<Origin, u32> = BTreeMap::new();
@@ -539,10 +542,11 @@ impl Slices {
                 }
                 let corners = piece
                     .iter()
-                    .map(|&(origin, _, position)| {
+                    .map(|&(origin, value, position)| {
                         *ids.entry(origin).or_insert_with(|| {
                             slices.points.push(position);
                             slices.origins.push(origin);
+                            slices.values.push(value);
                             slices.points.len() as u32 - 1
                         })
                     })
@@ -556,6 +560,11 @@ impl Slices {
     /// The position of point `id`.
     pub fn point(&self, id: u32) -> DVec3 {
         self.points[id as usize]
+    }
+
+    /// How many points the slices have.
+    pub fn point_count(&self) -> usize {
+        self.points.len()
     }
 
     /// The level point `id` lies on, if it is a crossing.
@@ -714,7 +723,21 @@ impl Slices {
             .map(|l| l.iter().copied().filter(|&i| kept[i as usize]).collect())
             .collect();
         let positions = |ids: &[u32]| ids.iter().map(|&i| self.point(i)).collect::<Vec<_>>();
-        let on = |ids: &[u32], level: usize| ids.iter().all(|&i| self.level_of(i) == Some(level));
+        // A loop is on a level if all its points are: crossings of the level, or a rim
+        // where the field is held at one value (a pole's) nearer that level.
+        let on = |ids: &[u32], level: usize| {
+            let rim = ids.iter().all(|&i| self.level_of(i).is_none())
+                && ids
+                    .windows(2)
+                    .all(|w| self.values[w[0] as usize] == self.values[w[1] as usize]);
+            let middle = 0.5 * (self.levels[region.band] + self.levels[region.band + 1]);
+            match ids.first() {
+                Some(&first) if rim => {
+                    (self.values[first as usize] < middle) == (level == region.band)
+                }
+                _ => ids.iter().all(|&i| self.level_of(i) == Some(level)),
+            }
+        };
         let lower: Vec<Vec<u32>> = loops
             .iter()
             .filter(|l| on(l, region.band))
@@ -1106,6 +1129,218 @@ fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
     best
 }
 
+/// The harmonic field of each connected part of `surface` between two poles (0 at
+/// one, 1 at the other, the cotangent Laplacian's zero elsewhere; faer's sparse
+/// Cholesky): level curves that run round the part like parallels between its ends,
+/// with saddles only where its shape needs them. The poles are the part's two points
+/// farthest apart or, on a part with rims, the rims nearest them (an open tube's
+/// levels then run parallel to its rims).
+pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
+    let n = surface.points.len();
+    let weights = cotangent_weights(surface);
+    let rims = rims(surface);
+    let mut field = vec![0.0; n];
+    for part in parts(surface) {
+        let fixed = pole_values(&surface.points, &part, &rims);
+        let mut index = vec![usize::MAX; n];
+        let free: Vec<u32> = part
+            .iter()
+            .copied()
+            .filter(|v| !fixed.contains_key(v))
+            .collect();
+        for (k, &v) in free.iter().enumerate() {
+            index[v as usize] = k;
+        }
+        let mut lower = Vec::new();
+        let mut rhs = vec![0.0; free.len()];
+        let mut diagonal = vec![0.0; free.len()];
+        for &(a, b, w) in &weights {
+            let (ia, ib) = (index[a as usize], index[b as usize]);
+            for (i, j, other) in [(ia, ib, b), (ib, ia, a)] {
+                if i == usize::MAX {
+                    continue;
+                }
+                diagonal[i] += w;
+                if j != usize::MAX {
+                    if j < i {
+                        lower.push(faer::sparse::Triplet::new(i, j, -w));
+                    }
+                } else if let Some(value) = fixed.get(&other) {
+                    rhs[i] += w * value;
+                }
+            }
+        }
+        // A hair on the diagonal keeps the system definite where weights vanish.
+        for (i, d) in diagonal.iter().enumerate() {
+            lower.push(faer::sparse::Triplet::new(
+                i,
+                i,
+                d + 1e-12 * d.abs().max(1.0),
+            ));
+        }
+        let solution = solve_lower(free.len(), &lower, &rhs)?;
+        for (&v, x) in free.iter().zip(solution) {
+            field[v as usize] = x;
+        }
+        for (&v, &value) in &fixed {
+            field[v as usize] = value;
+        }
+    }
+    Ok(field)
+}
+
+/// The field's fixed values on `part`: 0 and 1 at its two points farthest apart, or on
+/// the rims nearest them where those are two different rims.
+fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u32, f64> {
+    let [one, other] = poles(points, part);
+    let in_part: Vec<&Vec<u32>> = rims
+        .iter()
+        .filter(|r| part.binary_search(&r[0]).is_ok())
+        .collect();
+    let nearest = |pole: u32| {
+        in_part.iter().copied().min_by(|a, b| {
+            let d = |r: &Vec<u32>| {
+                r.iter()
+                    .map(|&v| points[v as usize].distance(points[pole as usize]))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            d(a).total_cmp(&d(b))
+        })
+    };
+    match (nearest(one), nearest(other)) {
+        (Some(a), Some(b)) if a != b => a
+            .iter()
+            .map(|&v| (v, 0.0))
+            .chain(b.iter().map(|&v| (v, 1.0)))
+            .collect(),
+        _ => BTreeMap::from([(one, 0.0), (other, 1.0)]),
+    }
+}
+
+/// The rims of `surface`: loops of the edges only one triangle uses, each as its
+/// points.
+fn rims(surface: &Triangles) -> Vec<Vec<u32>> {
+    let mut directed: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+    for t in &surface.corners {
+        for (a, b) in cycle_pairs(t) {
+            *directed.entry((a, b)).or_insert(0) += 1;
+        }
+    }
+    let mut next: BTreeMap<u32, u32> = BTreeMap::new();
+    for &(a, b) in directed.keys() {
+        if !directed.contains_key(&(b, a)) {
+            next.insert(a, b);
+        }
+    }
+    let mut rims = Vec::new();
+    while let Some((&start, _)) = next.iter().next() {
+        let mut rim = vec![start];
+        let mut at = start;
+        while let Some(to) = next.remove(&at) {
+            if to == start {
+                break;
+            }
+            rim.push(to);
+            at = to;
+        }
+        rims.push(rim);
+    }
+    rims
+}
+
+/// Solves the symmetric system given by its lower triangle's entries.
+fn solve_lower(
+    n: usize,
+    lower: &[faer::sparse::Triplet<usize, usize, f64>],
+    rhs: &[f64],
+) -> Result<Vec<f64>, String> {
+    use faer::linalg::solvers::Solve;
+    if n == 0 {
+        return Ok(Vec::new());
+    }
+    let matrix = faer::sparse::SparseColMat::<usize, f64>::try_new_from_triplets(n, n, lower)
+        .map_err(|e| format!("the field's system: {e:?}"))?;
+    let llt = matrix
+        .sp_cholesky(faer::Side::Lower)
+        .map_err(|e| format!("the field's system: {e:?}"))?;
+    let x = llt.solve(&faer::Mat::from_fn(n, 1, |i, _| rhs[i]));
+    let solution: Vec<f64> = (0..n).map(|i| x[(i, 0)]).collect();
+    if solution.iter().all(|x| x.is_finite()) {
+        Ok(solution)
+    } else {
+        Err("the field's system has no finite solution".into())
+    }
+}
+
+/// The least weight an edge keeps in the field's system.
+const LEAST_WEIGHT: f64 = 1e-6;
+
+/// Each edge of `surface` (once, lower corner first) with its cotangent weight: half
+/// the sum of the cotangents of the angles facing it, each kept within ±1000 (a
+/// needle triangle's would swamp the rest), the sum at least [`LEAST_WEIGHT`].
+fn cotangent_weights(surface: &Triangles) -> Vec<(u32, u32, f64)> {
+    let mut weights: BTreeMap<(u32, u32), f64> = BTreeMap::new();
+    for t in &surface.corners {
+        for k in 0..3 {
+            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let [pa, pb, pc] = [a, b, c].map(|i| surface.points[i as usize]);
+            let (u, v) = (pa - pc, pb - pc);
+            let cot = (u.dot(v) / u.cross(v).length().max(1e-300)).clamp(-1e3, 1e3);
+            *weights.entry((a.min(b), a.max(b))).or_insert(0.0) += 0.5 * cot;
+        }
+    }
+    // Negative weights (obtuse angles) kept a hair above zero: the system stays
+    // definite, and the field has no extremum but its poles.
+    weights
+        .into_iter()
+        .map(|((a, b), w)| (a, b, w.max(LEAST_WEIGHT)))
+        .collect()
+}
+
+/// The points of each connected part of `surface` (joined by triangles), each in
+/// increasing order, the parts by their first point.
+fn parts(surface: &Triangles) -> Vec<Vec<u32>> {
+    let n = surface.points.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn root(parent: &mut [u32], mut i: u32) -> u32 {
+        while parent[i as usize] != i {
+            parent[i as usize] = parent[parent[i as usize] as usize];
+            i = parent[i as usize];
+        }
+        i
+    }
+    let mut used = vec![false; n];
+    for t in &surface.corners {
+        for k in 0..3 {
+            used[t[k] as usize] = true;
+            let (a, b) = (root(&mut parent, t[k]), root(&mut parent, t[(k + 1) % 3]));
+            parent[a.max(b) as usize] = a.min(b);
+        }
+    }
+    let mut groups: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for v in (0..n as u32).filter(|&v| used[v as usize]) {
+        let r = root(&mut parent, v);
+        groups.entry(r).or_default().push(v);
+    }
+    groups.into_values().collect()
+}
+
+/// Two points of `part` far apart: the farthest from its first point, and the
+/// farthest from that.
+fn poles(points: &[DVec3], part: &[u32]) -> [u32; 2] {
+    let farthest = |from: u32| {
+        part.iter()
+            .copied()
+            .max_by(|&a, &b| {
+                let d = |v: u32| points[v as usize].distance_squared(points[from as usize]);
+                d(a).total_cmp(&d(b)).then(b.cmp(&a))
+            })
+            .unwrap_or(from)
+    };
+    let one = farthest(part[0]);
+    [one, farthest(one)]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1302,11 +1537,9 @@ mod tests {
     /// (measured again more finely over the whole), every corner on a strip's outline,
     /// edge lengths kept unrolled, the strips on either side of each level meeting at
     /// the same points. Returns how many strips.
-    fn check_strips(surface: &Triangles, axis: DVec3, tolerance: f64) -> usize {
-        let axis = axis.normalize();
-        let field: Vec<f64> = surface.points.iter().map(|p| p.dot(axis)).collect();
+    fn check_strips(surface: &Triangles, field: &[f64], tolerance: f64) -> usize {
         let clock = std::time::Instant::now();
-        let banded = strips_within(surface, &field, tolerance).unwrap();
+        let banded = strips_within(surface, field, tolerance).unwrap();
         eprintln!(
             "{} strips, {} levels, deviation {:.3} in {:?}",
             banded.strips.len(),
@@ -1337,17 +1570,22 @@ mod tests {
                 }
             }
         }
-        let levels = &banded.slices.levels;
-        for (j, &level) in levels.iter().enumerate().skip(1).take(levels.len() - 2) {
+        // Each point's level, by its position.
+        let slices = &banded.slices;
+        let key = |p: DVec3| p.to_array().map(f64::to_bits);
+        let level_at: BTreeMap<[u64; 3], usize> = (0..slices.point_count() as u32)
+            .filter_map(|i| slices.level_of(i).map(|l| (key(slices.point(i)), l)))
+            .collect();
+        for j in 1..slices.levels.len() - 1 {
             let on_level = |band: usize| {
-                let mut at: Vec<[i64; 3]> = banded
+                let mut at: Vec<[u64; 3]> = banded
                     .regions
                     .iter()
                     .zip(&banded.strips)
                     .filter(|(r, _)| r.band == band)
                     .flat_map(|(_, s)| s.points.iter())
-                    .filter(|p| (p.dot(axis) - level).abs() < 1e-9)
-                    .map(|p| (*p * 1e6).round().as_i64vec3().to_array())
+                    .map(|&p| key(p))
+                    .filter(|k| level_at.get(k) == Some(&j))
                     .collect();
                 at.sort();
                 at.dedup();
@@ -1356,6 +1594,27 @@ mod tests {
             assert_eq!(on_level(j - 1), on_level(j), "level {j}");
         }
         banded.strips.len()
+    }
+
+    /// The height of each point along `axis`.
+    fn along(surface: &Triangles, axis: DVec3) -> Vec<f64> {
+        let axis = axis.normalize();
+        surface.points.iter().map(|p| p.dot(axis)).collect()
+    }
+
+    #[test]
+    fn an_open_tube_between_its_rims_is_one_strip_and_a_cone_too() {
+        let tube = tube(32, 6, 120.0, |_| 40.0);
+        let field = two_pole_field(&tube).unwrap();
+        // Held at 0 and 1 on its rims (either way round), linear in between.
+        let up = field[0] == 0.0;
+        for (p, f) in tube.points.iter().zip(&field) {
+            let linear = if up { p.z / 120.0 } else { 1.0 - p.z / 120.0 };
+            assert!((f - linear).abs() < 1e-9, "{p} {f}");
+        }
+        assert_eq!(check_strips(&tube, &field, 1.0), 1);
+        let cone = super::tests::tube(32, 6, 120.0, |h| 60.0 - 0.3 * h);
+        assert_eq!(check_strips(&cone, &two_pole_field(&cone).unwrap(), 1.0), 1);
     }
 
     fn extent_of(points: &[DVec3]) -> f64 {
@@ -1367,8 +1626,11 @@ mod tests {
     #[test]
     fn strips_of_a_sphere_stay_within_the_bound_unroll_exactly_and_share_their_curves() {
         // A field along a tilted axis: its levels cross the grid's edges anywhere.
-        let strips = check_strips(&sphere(100.0, 48, 24), DVec3::new(0.3, 0.2, 0.93), 2.0);
+        let sphere = sphere(100.0, 48, 24);
+        let strips = check_strips(&sphere, &along(&sphere, DVec3::new(0.3, 0.2, 0.93)), 2.0);
         assert!(strips >= 3, "{strips}");
+        // Between two poles, the same.
+        check_strips(&sphere, &two_pole_field(&sphere).unwrap(), 2.0);
     }
 
     /// A torus about the z axis: `around` × `across` quads split into triangles.
@@ -1397,6 +1659,7 @@ mod tests {
     fn strips_of_a_torus_bridge_its_saddles() {
         // Along an axis in its plane the field has two saddles, where a band's
         // region has three loops.
-        check_strips(&torus(100.0, 40.0, 48, 24), DVec3::new(1.0, 0.2, 0.1), 2.0);
+        let torus = torus(100.0, 40.0, 48, 24);
+        check_strips(&torus, &along(&torus, DVec3::new(1.0, 0.2, 0.1)), 2.0);
     }
 }
