@@ -14,6 +14,7 @@ use super::map::{
     GAP,
 };
 use super::map_page::{fit, text_width};
+use crate::mesh::geometry::{bounding_box, vector_area};
 use crate::panel::surface::Patch;
 
 /// The least a close-up enlarges on the overview.
@@ -441,22 +442,14 @@ fn room(p: &Patch) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// A convex patch's area.
+/// A patch's area.
 fn area(p: &Patch) -> f64 {
-    let a = p.points[0];
-    p.points
-        .windows(2)
-        .skip(1)
-        .map(|w| (w[0] - a).cross(w[1] - a).dot(p.normal))
-        .sum::<f64>()
-        * 0.5
+    vector_area(p.points.iter().copied()).dot(p.normal)
 }
 
-/// The diagonal of the box round `points`.
+/// The diagonal of the box round `points` (0 for none).
 fn extent<'a>(points: impl Iterator<Item = &'a DVec3>) -> f64 {
-    let (lo, hi) = points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-        (lo.min(p), hi.max(p))
-    });
+    let (lo, hi) = bounding_box(points.copied());
     if lo.x > hi.x {
         0.0
     } else {

@@ -10,6 +10,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::mesh::distance::TriangleGrid;
+use crate::mesh::soup::{find, union};
 use crate::mesh::Mesh;
 
 /// A surface as triangles over shared corners, counter-clockwise seen from outside.
@@ -80,40 +81,48 @@ pub fn level_curves(surface: &Triangles, field: &[f64], level: f64) -> Vec<Curve
         let t = ((level - fa) / (fb - fa)).clamp(0.0, 1.0);
         surface.points[a as usize].lerp(surface.points[b as usize], t)
     };
-    let entered: std::collections::BTreeSet<(u32, u32)> = next.values().copied().collect();
-    let mut done = std::collections::BTreeSet::new();
-    let mut curves = Vec::new();
-    // Open curves first, from the edge nothing enters, then the loops.
-    let starts: Vec<(u32, u32)> = next
+    chains(&next)
+        .into_iter()
+        .map(|(edges, closed)| Curve {
+            points: edges.into_iter().map(crossing).collect(),
+            closed,
+        })
+        .collect()
+}
+
+/// The chains of `next` (each key to the one after it): the open ones from the keys
+/// nothing leads to, then the loops, each as its keys and whether it closes.
+fn chains<K: Ord + Copy>(next: &BTreeMap<K, K>) -> Vec<(Vec<K>, bool)> {
+    let entered: std::collections::BTreeSet<K> = next.values().copied().collect();
+    let starts: Vec<K> = next
         .keys()
         .filter(|k| !entered.contains(k))
         .chain(next.keys())
         .copied()
         .collect();
+    let mut done = std::collections::BTreeSet::new();
+    let mut chains = Vec::new();
     for start in starts {
-        if done.contains(&start) {
+        if !done.insert(start) {
             continue;
         }
-        let mut points = Vec::new();
+        let mut keys = vec![start];
         let mut at = start;
-        let closed = loop {
-            done.insert(at);
-            points.push(crossing(at));
-            match next.get(&at) {
-                Some(&n) if n == start => break true,
-                Some(&n) if !done.contains(&n) => at = n,
-                Some(&n) => {
-                    // The end of an open curve on the boundary.
-                    done.insert(n);
-                    points.push(crossing(n));
-                    break false;
-                }
-                None => break false,
+        let mut closed = false;
+        while let Some(&n) = next.get(&at) {
+            if n == start {
+                closed = true;
+                break;
             }
-        };
-        curves.push(Curve { points, closed });
+            if !done.insert(n) {
+                break;
+            }
+            keys.push(n);
+            at = n;
+        }
+        chains.push((keys, closed));
     }
-    curves
+    chains
 }
 
 /// `curve` with the fewest points (Douglas–Peucker) that keep every dropped point
@@ -648,14 +657,7 @@ impl Slices {
     /// The regions: per band, its pieces joined across shared edges, in band order
     /// and then by their first piece.
     pub fn regions(&self) -> Vec<Region> {
-        let mut parent: Vec<usize> = (0..self.pieces.len()).collect();
-        fn root(parent: &mut [usize], mut i: usize) -> usize {
-            while parent[i] != i {
-                parent[i] = parent[parent[i]];
-                i = parent[i];
-            }
-            i
-        }
+        let mut parent: Vec<u32> = (0..self.pieces.len() as u32).collect();
         let mut first_by_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
         for (k, (band, corners)) in self.pieces.iter().enumerate() {
             for (a, b) in cycle_pairs(corners) {
@@ -666,16 +668,15 @@ impl Slices {
                     std::collections::btree_map::Entry::Occupied(e) => {
                         let other = *e.get();
                         if self.pieces[other].0 == *band {
-                            let (x, y) = (root(&mut parent, other), root(&mut parent, k));
-                            parent[x.max(y)] = x.min(y);
+                            union(&mut parent, other as u32, k as u32);
                         }
                     }
                 }
             }
         }
-        let mut members: BTreeMap<(usize, usize), Vec<usize>> = BTreeMap::new();
+        let mut members: BTreeMap<(usize, u32), Vec<usize>> = BTreeMap::new();
         for k in 0..self.pieces.len() {
-            let r = root(&mut parent, k);
+            let r = find(&mut parent, k as u32);
             members.entry((self.pieces[k].0, r)).or_default().push(k);
         }
         members
@@ -687,31 +688,7 @@ impl Slices {
     /// The region of `band` made of `pieces`: its boundary (the piece edges no other
     /// of its pieces shares) chained into loops, and its triangles.
     fn region(&self, band: usize, pieces: &[usize]) -> Region {
-        let mut directed: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-        for &k in pieces {
-            for (a, b) in cycle_pairs(&self.pieces[k].1) {
-                *directed.entry((a, b)).or_insert(0) += 1;
-            }
-        }
-        let mut next: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
-        for &(a, b) in directed.keys() {
-            if !directed.contains_key(&(b, a)) {
-                next.entry(a).or_default().push(b);
-            }
-        }
-        let mut loops = Vec::new();
-        while let Some((&start, _)) = next.iter().find(|(_, to)| !to.is_empty()) {
-            let mut ring = vec![start];
-            let mut at = start;
-            while let Some(to) = next.get_mut(&at).and_then(|to| to.pop()) {
-                if to == start {
-                    break;
-                }
-                ring.push(to);
-                at = to;
-            }
-            loops.push(ring);
-        }
+        let loops = boundary_loops(pieces.iter().flat_map(|&k| cycle_pairs(&self.pieces[k].1)));
         let triangles = pieces
             .iter()
             .flat_map(|&k| {
@@ -748,33 +725,7 @@ impl Slices {
                 }
             }
         }
-        let entered: std::collections::BTreeSet<u32> = next.values().copied().collect();
-        let starts: Vec<u32> = next
-            .keys()
-            .filter(|k| !entered.contains(k))
-            .chain(next.keys())
-            .copied()
-            .collect();
-        let mut done = std::collections::BTreeSet::new();
-        for start in starts {
-            if done.contains(&start) {
-                continue;
-            }
-            let mut ids = vec![start];
-            done.insert(start);
-            let mut at = start;
-            let mut closed = false;
-            while let Some(&n) = next.get(&at) {
-                if n == start {
-                    closed = true;
-                    break;
-                }
-                if !done.insert(n) {
-                    break;
-                }
-                ids.push(n);
-                at = n;
-            }
+        for (ids, closed) in chains(&next) {
             let points: Vec<DVec3> = ids.iter().map(|&i| self.point(i)).collect();
             for (&id, k) in ids.iter().zip(kept_points(&points, closed, tolerance)) {
                 keep[id as usize] |= k;
@@ -1290,32 +1241,34 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
 /// The rims of `surface`: loops of the edges only one triangle uses, each as its
 /// points.
 fn rims(surface: &Triangles) -> Vec<Vec<u32>> {
-    let mut directed: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-    for t in &surface.corners {
-        for (a, b) in cycle_pairs(t) {
-            *directed.entry((a, b)).or_insert(0) += 1;
+    boundary_loops(surface.corners.iter().flat_map(|t| cycle_pairs(t)))
+}
+
+/// The loops of the directed edges (each a face's side, faces counter-clockwise)
+/// whose reverse is not among them: a surface's boundary, the surface on each loop's
+/// left, the loops from their least point.
+fn boundary_loops(edges: impl Iterator<Item = (u32, u32)>) -> Vec<Vec<u32>> {
+    let directed: std::collections::BTreeSet<(u32, u32)> = edges.collect();
+    let mut next: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+    for &(a, b) in &directed {
+        if !directed.contains(&(b, a)) {
+            next.entry(a).or_default().push(b);
         }
     }
-    let mut next: BTreeMap<u32, u32> = BTreeMap::new();
-    for &(a, b) in directed.keys() {
-        if !directed.contains_key(&(b, a)) {
-            next.insert(a, b);
-        }
-    }
-    let mut rims = Vec::new();
-    while let Some((&start, _)) = next.iter().next() {
-        let mut rim = vec![start];
+    let mut loops = Vec::new();
+    while let Some((&start, _)) = next.iter().find(|(_, to)| !to.is_empty()) {
+        let mut ring = vec![start];
         let mut at = start;
-        while let Some(to) = next.remove(&at) {
+        while let Some(to) = next.get_mut(&at).and_then(|to| to.pop()) {
             if to == start {
                 break;
             }
-            rim.push(to);
+            ring.push(to);
             at = to;
         }
-        rims.push(rim);
+        loops.push(ring);
     }
-    rims
+    loops
 }
 
 /// Solves the symmetric system given by its lower triangle's entries.
@@ -1372,24 +1325,16 @@ fn cotangent_weights(surface: &Triangles) -> Vec<(u32, u32, f64)> {
 fn parts(surface: &Triangles) -> Vec<Vec<u32>> {
     let n = surface.points.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
-    fn root(parent: &mut [u32], mut i: u32) -> u32 {
-        while parent[i as usize] != i {
-            parent[i as usize] = parent[parent[i as usize] as usize];
-            i = parent[i as usize];
-        }
-        i
-    }
     let mut used = vec![false; n];
     for t in &surface.corners {
         for k in 0..3 {
             used[t[k] as usize] = true;
-            let (a, b) = (root(&mut parent, t[k]), root(&mut parent, t[(k + 1) % 3]));
-            parent[a.max(b) as usize] = a.min(b);
+            union(&mut parent, t[k], t[(k + 1) % 3]);
         }
     }
     let mut groups: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     for v in (0..n as u32).filter(|&v| used[v as usize]) {
-        let r = root(&mut parent, v);
+        let r = find(&mut parent, v);
         groups.entry(r).or_default().push(v);
     }
     groups.into_values().collect()
