@@ -14,7 +14,6 @@ use super::map::{
     GAP,
 };
 use super::map_page::{fit, text_width};
-use crate::mesh::geometry::{bounding_box, vector_area};
 use crate::panel::surface::Patch;
 
 /// The least a close-up enlarges on the overview.
@@ -442,14 +441,22 @@ fn room(p: &Patch) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// A patch's area.
+/// A convex patch's area.
 fn area(p: &Patch) -> f64 {
-    vector_area(p.points.iter().copied()).dot(p.normal)
+    let a = p.points[0];
+    p.points
+        .windows(2)
+        .skip(1)
+        .map(|w| (w[0] - a).cross(w[1] - a).dot(p.normal))
+        .sum::<f64>()
+        * 0.5
 }
 
-/// The diagonal of the box round `points` (0 for none).
+/// The diagonal of the box round `points`.
 fn extent<'a>(points: impl Iterator<Item = &'a DVec3>) -> f64 {
-    let (lo, hi) = bounding_box(points.copied());
+    let (lo, hi) = points.fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+        (lo.min(p), hi.max(p))
+    });
     if lo.x > hi.x {
         0.0
     } else {
