@@ -573,7 +573,10 @@ pub fn export(
     ));
     let map = job.map.then(|| {
         let surface = crate::panel::surface::panel_surface(
-            &prepared.scheme_mesh.mesh,
+            output
+                .surface
+                .as_ref()
+                .unwrap_or(&prepared.scheme_mesh.mesh),
             &output.panels,
             &output.face_groups,
         );
@@ -880,8 +883,15 @@ fn build_manifest(
     let panel_area: f64 = flat.iter().map(|p| p.area).sum();
     let usable = sheet.usable_width() * sheet.usable_height();
     let lower_bound = (panel_area / usable).ceil() as usize;
-    // Faces made by splitting or simplification have no face in the input file.
-    let input_face = |f: u32| Some(mesh.face_source(FaceId(f))).filter(|&s| s != u32::MAX);
+    // Faces made by splitting or simplification, or of a scheme's own surface, have no
+    // face in the input file.
+    let input_face = |f: u32| {
+        let source = output
+            .surface
+            .is_none()
+            .then(|| mesh.face_source(FaceId(f)));
+        source.filter(|&s| s != u32::MAX)
+    };
     let panels = manifest::panel_entries(flat, layout, input_face, &output.face_groups);
     Manifest {
         tool: manifest::Tool {

@@ -172,7 +172,7 @@ pub fn check_labels(
 /// them would have none, and the long stages would take minutes to make them
 /// ([`too_detailed`]). A build with `--build-anyway` goes on; the later checks warn.
 pub fn check_detail(job: &Job, mesh: &Mesh, budget: &dyn Fn() -> Option<Suggestion>) -> Result<()> {
-    if job.build_anyway {
+    if job.build_anyway || !job.scheme.panels_follow_faces() {
         return Ok(());
     }
     let Some((median, buildable)) = median_too_short(job, mesh) else {
@@ -240,6 +240,16 @@ fn too_detailed(
     most: bool,
     budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<String> {
+    // Panels the scheme shapes itself grow with its own options, not with a budget.
+    if !job.scheme.panels_follow_faces() {
+        let warning = format!(
+            "the {} panels are too small for this size: {what}; try {}",
+            job.scheme.name(),
+            job.scheme.larger_panels_fix()
+        );
+        strict(job, std::slice::from_ref(&warning))?;
+        return Ok(warning);
+    }
     let suggestion = budget();
     let fixes = detail_fixes(job, mesh, suggestion);
     if job.build_anyway || (job.model.budget.is_some() && !most) {

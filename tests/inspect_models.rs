@@ -274,11 +274,18 @@ fn inspect_lists_what_preparation_would_split_and_builds_agree() {
         .collect();
     assert_eq!(
         listed,
-        ["half-edge", "quad-edge", "winged-edge", "woven", "net"]
+        [
+            "half-edge",
+            "quad-edge",
+            "winged-edge",
+            "woven",
+            "net",
+            "strip"
+        ]
     );
     assert_eq!(preparation("half-edge")["faces"], "star-shaped");
     assert_eq!(preparation("half-edge")["misshapen"], 0);
-    for scheme in ["quad-edge", "winged-edge", "woven", "net"] {
+    for scheme in ["quad-edge", "winged-edge", "woven", "net", "strip"] {
         assert_eq!(preparation(scheme)["faces"], "convex", "{scheme}");
         assert_eq!(preparation(scheme)["misshapen"], 2, "{scheme}");
     }

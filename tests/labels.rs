@@ -226,14 +226,19 @@ fn no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme() {
         return;
     };
     let models = common::build::shared_model_files(&shared);
+    let tmp = TempDir::new().unwrap();
     // The README's build: 4 ft at the thesis budget of 625 edges; and 2 ft, where the
     // panels are small and the labels compete for room.
     let mut surveyed = 0;
     for model in &models {
+        // The woven scheme weaves only a closed mesh.
+        let simplified =
+            [false, true].map(|fill| common::build::simplified_obj(model, 625, fill, tmp.path()));
         for scheme in ["half-edge", "quad-edge", "winged-edge", "woven", "net"] {
+            let simplified = &simplified[usize::from(scheme == "woven")];
             for size in ["2ft", "4ft"] {
                 let name = format!("{} {scheme} {size}", model.display());
-                let Some(panels) = fitted(model, scheme, size, Some(625)) else {
+                let Some(panels) = fitted(simplified, scheme, size, None) else {
                     eprintln!("{name}: not built (larger than the sheet)");
                     continue;
                 };

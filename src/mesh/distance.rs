@@ -84,12 +84,21 @@ impl<'a> TriangleGrid<'a> {
             (lo, hi)
         };
         let size = (hi - lo).max(DVec3::splat(1e-12));
-        // Cells of equal sides, about as many as triangles (at most 256 a side).
+        let boxes: Vec<(DVec3, DVec3)> = triangles
+            .iter()
+            .map(|t| super::geometry::bounding_box(t.iter().copied()))
+            .collect();
+        // Cells of equal sides, about as many as triangles (at most 256 a side), and no
+        // smaller than a typical triangle: a flat set of large triangles (a planar
+        // strip) would otherwise fill thousands of cells each.
         let volume = size.x * size.y * size.z;
         let n = triangles.len().max(1) as f64;
         let mut cell = (volume / n).cbrt();
         let longest = size.max_element();
-        cell = cell.max(longest / 256.0);
+        let mut extents: Vec<f64> = boxes.iter().map(|(a, b)| (*b - *a).max_element()).collect();
+        extents.sort_by(f64::total_cmp);
+        let typical = extents.get(extents.len() / 2).copied().unwrap_or(0.0);
+        cell = cell.max(longest / 256.0).max(0.5 * typical);
         if !cell.is_finite() || cell <= 0.0 {
             cell = longest.max(1e-12);
         }
@@ -98,10 +107,7 @@ impl<'a> TriangleGrid<'a> {
         let cells = dims[0] * dims[1] * dims[2];
         let mut counts = vec![0u32; cells + 1];
         let mut ranges = Vec::with_capacity(triangles.len());
-        let mut boxes = Vec::with_capacity(triangles.len());
-        for t in triangles {
-            let (tlo, thi) = super::geometry::bounding_box(t.iter().copied());
-            boxes.push((tlo, thi));
+        for &(tlo, thi) in &boxes {
             let range = [0, 1, 2].map(|k| (index(tlo, k), index(thi, k)));
             for z in range[2].0..=range[2].1 {
                 for y in range[1].0..=range[1].1 {

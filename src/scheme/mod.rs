@@ -28,12 +28,13 @@ use crate::panel::{FaceGroup, Name, Panels};
 use crate::record::{round4, Params};
 
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
-pub static SCHEMES: [&dyn Scheme; 5] = [
+pub static SCHEMES: [&dyn Scheme; 6] = [
     &half_edge::HalfEdge,
     &quad_edge::QuadEdge,
     &winged_edge::WingedEdge,
     &woven::Woven,
     &net::Net,
+    &strip::Strips,
 ];
 
 /// A panel scheme: what the command line, the config file and the pipeline need of it.
@@ -81,6 +82,18 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     /// are. Only exactly flat hinges unless the scheme says otherwise.
     fn least_scored_fold(&self) -> f64 {
         crate::flatten::LEAST_SCORED_FOLD
+    }
+    /// True when its panels follow the mesh's faces, so that a mesh too detailed for
+    /// its size makes panels too small for their ids (checked before the build). A
+    /// scheme that shapes its panels itself (the strip scheme) says false.
+    fn panels_follow_faces(&self) -> bool {
+        true
+    }
+    /// For a scheme whose panels do not follow the faces: the fix that makes them
+    /// large enough for their labels and fasteners, named in the warning when they are
+    /// not ("a larger --max-deviation (wider strips) or a larger --size").
+    fn larger_panels_fix(&self) -> &'static str {
+        "a larger --size"
     }
 }
 
@@ -362,6 +375,16 @@ impl ConfiguredScheme {
         self.options.least_scored_fold()
     }
 
+    /// True when its panels follow the mesh's faces ([`Configured::panels_follow_faces`]).
+    pub fn panels_follow_faces(&self) -> bool {
+        self.options.panels_follow_faces()
+    }
+
+    /// What makes its panels larger ([`Configured::larger_panels_fix`]).
+    pub fn larger_panels_fix(&self) -> &'static str {
+        self.options.larger_panels_fix()
+    }
+
     /// The manifest's `scheme.params`: the shared options, then the scheme's own.
     pub fn params(&self) -> Params {
         let panel = self.panel();
@@ -409,6 +432,10 @@ pub struct SchemeOutput {
     /// The mesh faces of each panel that covers a group of faces (`Covers::Faces(k)`
     /// is entry k), each list in increasing order.
     pub face_groups: Vec<FaceGroup>,
+    /// The surface the panels are built on, where the scheme makes its own (the strip
+    /// scheme's strips): face groups name its faces, and the map shows it instead of
+    /// the scheme's mesh.
+    pub surface: Option<Mesh>,
 }
 
 /// A build where more than this fraction of the connections holds no fastener hole

@@ -79,7 +79,28 @@ pub static MATCH: IdKind = IdKind {
 pub struct Net;
 
 /// `--flat-fold` (degrees).
-const FLAT_FOLD_DEG: f64 = 1.0;
+pub(super) const FLAT_FOLD_DEG: f64 = 1.0;
+
+/// `--flat-fold`, shared with the strip scheme.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub(super) struct FlatFoldArgs {
+    /// Folds flatter than this angle in degrees are not scored.
+    #[arg(long, value_name = "DEGREES")]
+    flat_fold: Option<f64>,
+}
+
+impl FlatFoldArgs {
+    /// The angle (radians), checked, or its default.
+    pub(super) fn angle(&self) -> Result<f64, String> {
+        let flat_fold = self.flat_fold.unwrap_or(FLAT_FOLD_DEG);
+        if !(0.0..90.0).contains(&flat_fold) {
+            return Err(format!(
+                "--flat-fold: {flat_fold} must be an angle in degrees from 0 to below 90"
+            ));
+        }
+        Ok(flat_fold.to_radians())
+    }
+}
 
 /// The net scheme's options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
@@ -91,9 +112,8 @@ struct NetArgs {
     #[arg(long, value_name = "N")]
     max_island_faces: Option<usize>,
 
-    /// Folds flatter than this angle in degrees are not scored (net scheme).
-    #[arg(long, value_name = "DEGREES")]
-    flat_fold: Option<f64>,
+    #[command(flatten)]
+    flat_fold: FlatFoldArgs,
 
     /// Largest ratio of an island's convex hull to its area (net scheme, at least 1):
     /// smaller keeps islands compact so they pack on fewer sheets, larger makes fewer
@@ -166,12 +186,6 @@ impl Scheme for Net {
         if args.max_island_faces == Some(0) {
             return Err("--max-island-faces: an island holds at least 1 face".into());
         }
-        let flat_fold = args.flat_fold.unwrap_or(FLAT_FOLD_DEG);
-        if !(0.0..90.0).contains(&flat_fold) {
-            return Err(format!(
-                "--flat-fold: {flat_fold} must be an angle in degrees from 0 to below 90"
-            ));
-        }
         let island_spread = args.island_spread.unwrap_or(ISLAND_SPREAD);
         if !(island_spread >= 1.0 && island_spread.is_finite()) {
             return Err(format!(
@@ -183,7 +197,7 @@ impl Scheme for Net {
             panel,
             tab_height: args.tab.height()?,
             max_island_faces: args.max_island_faces,
-            flat_fold: flat_fold.to_radians(),
+            flat_fold: args.flat_fold.angle()?,
         }))
     }
 }
@@ -386,6 +400,13 @@ impl Islands {
             grid,
             fold: vec![false; mesh.edge_count()],
         }
+    }
+
+    /// Every face its own island, bucketed in cells twice the median of the edge
+    /// `lengths` (sorted).
+    fn of_faces(mesh: &Mesh, lengths: &[f64]) -> Self {
+        let median = lengths.get(lengths.len() / 2).copied().unwrap_or(1.0);
+        Islands::new(mesh, 2.0 * median.max(1e-3))
     }
 
     /// Face `f`'s flat polygon in its island's frame.
@@ -959,6 +980,69 @@ fn place_tabs(
 /// Builds the islands of a mesh whose faces are planar and convex.
 pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
     let (islands, order) = grow_islands(mesh, options);
+    let net = island_net(mesh, options, islands, &order, &IslandNames::Numbered);
+    let mut output = net.output;
+    output.report = net.summary.report("net", "islands");
+    output.manifest.push("net", net.summary.section("islands"));
+    output
+}
+
+/// How a net's islands are named and what of the model they cover.
+pub enum IslandNames<'a> {
+    /// `N1`, `N2`, … in the order of their lowest face; each covers its faces.
+    Numbered,
+    /// Named by the scheme from every island's faces (in the order of their lowest
+    /// face, each list increasing).
+    Own(&'a dyn Fn(&[Vec<u32>]) -> Vec<Name>),
+}
+
+/// A net and what its report says of it.
+pub struct IslandNet {
+    /// Its panels, connections and notes (no report or manifest lines yet).
+    pub output: SchemeOutput,
+    /// Its counts, for the scheme's report and manifest.
+    pub summary: Summary,
+}
+
+/// Islands grown only along `folds`, in that order, each join still keeping the
+/// island clear of itself and on the sheet with room for its tabs; every other
+/// interior edge is cut and gets a tab. For a scheme that chooses its folds itself
+/// (the strip scheme's rungs).
+pub fn islands_along(
+    mesh: &Mesh,
+    options: &NetOptions,
+    folds: &[EdgeId],
+    names: &IslandNames,
+) -> IslandNet {
+    let lengths = mesh.sorted_edge_lengths();
+    let mut islands = Islands::of_faces(mesh, &lengths);
+    let component_faces = vec![usize::MAX; mesh.face_count()];
+    let rules = JoinRules {
+        options,
+        scale: lengths.last().copied().unwrap_or(1.0),
+        spread: f64::INFINITY,
+        small: usize::MAX,
+        component_faces: &component_faces,
+    };
+    for &e in folds {
+        islands.try_join(mesh, e, &rules);
+    }
+    let interior: Vec<EdgeId> = mesh
+        .edges()
+        .filter(|&e| fold_angle(mesh, e).is_some())
+        .collect();
+    island_net(mesh, options, islands, &interior, names)
+}
+
+/// The panels of grown islands: tabs on the interior edges of `order` left cut, the
+/// islands numbered in the order of their lowest face.
+fn island_net(
+    mesh: &Mesh,
+    options: &NetOptions,
+    islands: Islands,
+    order: &[EdgeId],
+    names: &IslandNames,
+) -> IslandNet {
     let cuts: Vec<EdgeId> = order
         .iter()
         .filter(|e| !islands.fold[e.index()])
@@ -980,6 +1064,12 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
         })
         .collect();
     members.sort();
+    let ids: Vec<Name> = match names {
+        IslandNames::Numbered => (1..=members.len() as u32)
+            .map(|k| Name::new(&ISLAND, k))
+            .collect(),
+        IslandNames::Own(name) => name(&members),
+    };
     let mut number = vec![0u32; mesh.face_count()];
     let mut facet_of = vec![0u32; mesh.face_count()];
     for (k, faces) in members.iter().enumerate() {
@@ -1003,7 +1093,10 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
     let built: Vec<Panel> = members
         .iter()
         .enumerate()
-        .map(|(k, faces)| island_panel(&net, k as u32 + 1, faces))
+        .map(|(k, faces)| {
+            let covers = Covers::Faces(k as u32);
+            island_panel(&net, Source { id: ids[k], covers }, faces)
+        })
         .collect();
 
     let tab_count = tabs.iter().flatten().count();
@@ -1011,20 +1104,23 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
     let summary = Summary::of(
         mesh, &islands, &members, &cuts, tab_count, shortened, options,
     );
-    SchemeOutput {
-        panels: built.into_iter().collect(),
-        connections: cuts.len(),
-        notes: tab_notes(cuts.len(), tab_count, shortened),
-        report: summary.report(),
-        manifest: summary.manifest(),
-        unfastened: unfastened(mesh, &cuts, &tabs, &number, options),
-        face_groups: members
-            .into_iter()
-            .map(|faces| FaceGroup {
-                anchor: group_anchor(mesh, &faces),
-                faces,
-            })
-            .collect(),
+    let face_groups = members
+        .into_iter()
+        .map(|faces| FaceGroup {
+            anchor: group_anchor(mesh, &faces),
+            faces,
+        })
+        .collect();
+    IslandNet {
+        output: SchemeOutput {
+            panels: built.into_iter().collect(),
+            connections: cuts.len(),
+            notes: tab_notes(cuts.len(), tab_count, shortened),
+            unfastened: unfastened(mesh, &cuts, &tabs, (&number, &ids), options),
+            face_groups,
+            ..SchemeOutput::default()
+        },
+        summary,
     }
 }
 
@@ -1033,13 +1129,7 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
 /// edges in that order (the sharp ones, left to be cut, last).
 fn grow_islands(mesh: &Mesh, options: &NetOptions) -> (Islands, Vec<EdgeId>) {
     let lengths = mesh.sorted_edge_lengths();
-    let cell = 2.0
-        * lengths
-            .get(lengths.len() / 2)
-            .copied()
-            .unwrap_or(1.0)
-            .max(1e-3);
-    let mut islands = Islands::new(mesh, cell);
+    let mut islands = Islands::of_faces(mesh, &lengths);
     let mut order: Vec<(f64, EdgeId)> = mesh
         .edges()
         .filter_map(|e| fold_angle(mesh, e).map(|a| (a, e)))
@@ -1094,7 +1184,7 @@ fn unfastened(
     mesh: &Mesh,
     cuts: &[EdgeId],
     tabs: &[Option<Tab>],
-    number: &[u32],
+    (number, ids): (&[u32], &[Name]),
     options: &NetOptions,
 ) -> Vec<ConnectionName> {
     if options.panel.holes == 0 {
@@ -1107,8 +1197,8 @@ fn unfastened(
             let (f, g) = (mesh.face(h)?, mesh.face(h.twin())?);
             Some(ConnectionName {
                 panels: [
-                    Name::new(&ISLAND, number[f.index()]),
-                    Name::new(&ISLAND, number[g.index()]),
+                    ids[number[f.index()] as usize - 1],
+                    ids[number[g.index()] as usize - 1],
                 ],
                 at: Name::edge(e.0),
             })
@@ -1141,16 +1231,12 @@ struct PanelParts {
 /// Builds island `number`'s panel: its faces (facets in face order, corners shared
 /// along folds), then the tabs its faces own; the island id on a central face, match
 /// numbers at every cut edge on both sides.
-fn island_panel(net: &BuiltNet, number: u32, faces: &[u32]) -> Panel {
+fn island_panel(net: &BuiltNet, source: Source, faces: &[u32]) -> Panel {
     let mut parts = PanelParts::default();
     let tab_bases = island_faces(net, faces, &mut parts);
     tab_facets(net, tab_bases, &mut parts);
     folded_holes(net, faces, &mut parts);
-    parts.labels.push(island_label(net, number, faces));
-    let source = Source {
-        id: Name::new(&ISLAND, number),
-        covers: Covers::Faces(number - 1),
-    };
+    parts.labels.push(island_label(net, source.id, faces));
     Panel::new(
         source,
         parts.vertices,
@@ -1262,7 +1348,7 @@ fn folded_holes(net: &BuiltNet, faces: &[u32], parts: &mut PanelParts) {
 
 /// The island's id on the largest face near its middle, along that face's longest
 /// edge.
-fn island_label(net: &BuiltNet, number: u32, faces: &[u32]) -> Label {
+fn island_label(net: &BuiltNet, id: Name, faces: &[u32]) -> Label {
     let mesh = net.mesh;
     let label_face = central_face(mesh, net.islands, faces);
     let corners: Vec<DVec3> = mesh.face_positions(FaceId(label_face)).collect();
@@ -1274,7 +1360,7 @@ fn island_label(net: &BuiltNet, number: u32, faces: &[u32]) -> Label {
         })
         .unwrap_or(0);
     Label {
-        text: Name::new(&ISLAND, number),
+        text: id,
         anchor: mesh.face_centre(FaceId(label_face)),
         direction: (corners[(longest + 1) % corners.len()] - corners[longest]).normalize(),
         height: net.options.panel.label_height,
@@ -1315,7 +1401,7 @@ fn central_face(mesh: &Mesh, islands: &Islands, faces: &[u32]) -> u32 {
 }
 
 /// What the report and the manifest say of the islands.
-struct Summary {
+pub struct Summary {
     islands: usize,
     largest: usize,
     median: usize,
@@ -1374,9 +1460,10 @@ impl Summary {
         }
     }
 
-    fn report(&self) -> Vec<String> {
+    /// The report's line, headed `scheme` and calling the islands `islands`.
+    pub fn report(&self, scheme: &str, islands: &str) -> Vec<String> {
         vec![format!(
-            "net: {} islands (largest {} faces, median {}); folds {} mountain, {} valley, {} too flat to score, {} in all; {} cut edges, {} in all, with {} tabs",
+            "{scheme}: {} {islands} (largest {} faces, median {}); folds {} mountain, {} valley, {} too flat to score, {} in all; {} cut edges, {} in all, with {} tabs",
             self.islands,
             self.largest,
             self.median,
@@ -1390,14 +1477,10 @@ impl Summary {
         )]
     }
 
-    fn manifest(&self) -> Params {
-        let mut params = Params::default();
-        params.push(
-            "net",
-            serde_json::json!({
-                "islands": self.islands,
-                "largest_island_faces": self.largest,
-                "median_island_faces": self.median,
+    /// The manifest's section of the islands, counting them as `islands`.
+    pub fn section(&self, islands: &str) -> serde_json::Value {
+        let singular = islands.trim_end_matches('s');
+        let mut section = serde_json::json!({
                 "folds_mountain": self.folds[0],
                 "folds_valley": self.folds[1],
                 "folds_flat": self.folds[2],
@@ -1406,9 +1489,11 @@ impl Summary {
                 "cut_length": round4(self.cut_length),
                 "tabs": self.tabs,
                 "tabs_shortened": self.shortened,
-            }),
-        );
-        params
+        });
+        section[islands] = self.islands.into();
+        section[format!("largest_{singular}_faces")] = self.largest.into();
+        section[format!("median_{singular}_faces")] = self.median.into();
+        section
     }
 }
 

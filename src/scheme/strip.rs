@@ -1,17 +1,350 @@
-//! The geometry of developable strips: the level curves of a scalar field on a
-//! triangulated surface, the band of triangles between two neighbouring curves that
-//! bends least (every corner on one of the two curves, so no vertex is inside the
-//! band and it unrolls exactly; the dynamic programme of the strip paper, `003`), the
-//! band unrolled, and the distance between bands and the surface measured both ways.
+//! The strip scheme: the model covered by developable strips within a distance of it,
+//! both ways, each strip cut into pieces that fit the sheet, glue tabs on the curves
+//! between strips.
+//!
+//! The strips follow the level curves of a field between two poles of each part of
+//! the model (`two_pole_field`); between two neighbouring curves, the band of
+//! triangles that bends least (every corner on one of the two curves, so no vertex is
+//! inside the band and it unrolls exactly; the dynamic programme of the strip paper,
+//! `003`). Bands whose strips stray from the model further than `--max-deviation`,
+//! measured both ways, are split by curves between (`strips_within`). The strips are
+//! welded into one surface where they share their curves' points; the net scheme's
+//! islands then grow along each strip's rungs in order, so a piece is a run of its
+//! strip, as long as keeps it clear of itself and on the sheet, and every curve
+//! between strips (and the rung between two pieces) gets a tab with match numbers.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
+use super::net::{islands_along, FlatFoldArgs, IslandNames, NetOptions, FLAT_FOLD_DEG};
+use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
+use super::{Scheme, SchemeError, SchemeOutput};
 use crate::mesh::distance::TriangleGrid;
 use crate::mesh::soup::{find, union};
-use crate::mesh::Mesh;
+use crate::mesh::{EdgeId, FaceId, Mesh};
+use crate::option_default::{state_defaults, OptionDefault};
+use crate::panel::{IdKind, Name};
+use crate::record::{round4, Params};
+
+/// Strip pieces: `S3.2`, piece 2 of strip 3; `S3` for a strip in one piece.
+pub static STRIP: IdKind = IdKind {
+    letter: "S",
+    legend: "strip piece (strip.piece)",
+    noun: "strip",
+    part_noun: "piece",
+};
+
+/// The default `--max-deviation`: a percentage of the built model's bounding-box
+/// diagonal, about what the eye takes for smooth at arm's length.
+const MAX_DEVIATION_PERCENT: f64 = 0.5;
+
+/// The strip scheme: developable strips within a distance of the model.
+pub struct Strips;
+
+/// The strip scheme's options as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+struct StripArgs {
+    #[command(flatten)]
+    tab: TabArgs,
+
+    #[command(flatten)]
+    flat_fold: FlatFoldArgs,
+
+    /// Largest distance between the strips and the model, both ways (strip scheme): a
+    /// length with a unit, or a percentage of the built model's bounding-box diagonal.
+    #[arg(long, value_name = "LENGTH|P%")]
+    max_deviation: Option<String>,
+}
+
+/// How far the strips may stray from the model.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Deviation {
+    /// A length (mm).
+    Length(f64),
+    /// A fraction of the built model's bounding-box diagonal.
+    Fraction(f64),
+}
+
+impl Deviation {
+    /// Parses `--max-deviation`: `2mm`, `0.1in` or `0.5%`.
+    fn parse(text: &str) -> Result<Deviation, String> {
+        let fix = "write a length with a unit (2mm) or a percentage of the model's diagonal (0.5%)";
+        let deviation = match text.trim().strip_suffix('%') {
+            Some(percent) => percent
+                .trim()
+                .parse::<f64>()
+                .map(|p| Deviation::Fraction(p / 100.0))
+                .map_err(|_| format!("--max-deviation: '{text}' is not a percentage; {fix}"))?,
+            None => crate::units::parse_length(text)
+                .map(Deviation::Length)
+                .map_err(|e| format!("--max-deviation: {e}"))?,
+        };
+        let value = match deviation {
+            Deviation::Length(v) | Deviation::Fraction(v) => v,
+        };
+        if !(value > 0.0 && value.is_finite()) {
+            return Err(format!(
+                "--max-deviation: '{text}' must be above zero; {fix}"
+            ));
+        }
+        Ok(deviation)
+    }
+
+    /// The distance (mm) for a model of bounding-box diagonal `diagonal` (mm).
+    pub fn length(self, diagonal: f64) -> f64 {
+        match self {
+            Deviation::Length(mm) => mm,
+            Deviation::Fraction(f) => f * diagonal,
+        }
+    }
+}
+
+/// The strip scheme's options, resolved (lengths in mm).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StripOptions {
+    /// The tabs, the sheet and the folds, as the net scheme takes them.
+    pub net: NetOptions,
+    /// `--max-deviation`.
+    pub max_deviation: Deviation,
+}
+
+impl Scheme for Strips {
+    fn name(&self) -> &'static str {
+        "strip"
+    }
+
+    fn about(&self) -> &'static str {
+        "developable strips within --max-deviation of the model, cut into pieces that fit the sheet, glue tabs between them"
+    }
+
+    fn options(&self) -> Vec<clap::Arg> {
+        state_defaults(
+            args_of::<StripArgs>(),
+            &[
+                tab_defaults(),
+                OptionDefault::value("flat-fold", FLAT_FOLD_DEG),
+                OptionDefault::words("max-deviation", "0.5%"),
+            ],
+        )
+    }
+
+    fn defaults(&self) -> PanelDefaults {
+        TAB_DEFAULTS
+    }
+
+    fn needs_convex_faces(&self) -> bool {
+        // Faces are fanned into triangles from their first corner.
+        true
+    }
+
+    fn overlap_fix(&self) -> &'static str {
+        "a smaller --tab-height (shorter tabs)"
+    }
+
+    fn configure(
+        &self,
+        values: &OptionValues,
+        panel: PanelOptions,
+    ) -> Result<Box<dyn Configured>, String> {
+        let args: StripArgs = values.parse()?;
+        if panel.face_scale != 1.0 {
+            return Err(format!(
+                "--face-scale: the strip scheme keeps its strips whole (1), not {}; leave it out",
+                panel.face_scale
+            ));
+        }
+        let max_deviation = match args.max_deviation.as_deref() {
+            Some(text) => Deviation::parse(text)?,
+            None => Deviation::Fraction(MAX_DEVIATION_PERCENT / 100.0),
+        };
+        Ok(Box::new(StripOptions {
+            net: NetOptions {
+                panel,
+                tab_height: args.tab.height()?,
+                max_island_faces: None,
+                flat_fold: args.flat_fold.angle()?,
+                island_spread: f64::INFINITY,
+            },
+            max_deviation,
+        }))
+    }
+}
+
+impl Configured for StripOptions {
+    fn panel(&self) -> &PanelOptions {
+        &self.net.panel
+    }
+
+    fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
+        strip_panels(mesh, self)
+    }
+
+    fn params(&self) -> Params {
+        let mut params = Params::default();
+        params.push("tab_height", round4(self.net.tab_height));
+        params.push("flat_fold_deg", round4(self.net.flat_fold.to_degrees()));
+        match self.max_deviation {
+            Deviation::Length(mm) => params.push("max_deviation", round4(mm)),
+            Deviation::Fraction(f) => {
+                params.push("max_deviation", format!("{}%", round4(100.0 * f)))
+            }
+        }
+        params
+    }
+
+    fn least_scored_fold(&self) -> f64 {
+        self.net.flat_fold
+    }
+
+    fn panels_follow_faces(&self) -> bool {
+        // Strips follow the field's levels, their width set by --max-deviation.
+        false
+    }
+
+    fn larger_panels_fix(&self) -> &'static str {
+        "a larger --max-deviation (wider strips) or a larger --size"
+    }
+}
+
+/// The strips of `mesh` within the bound, welded into one surface and cut into pieces
+/// with tabs.
+fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, SchemeError> {
+    let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
+    let tolerance = options.max_deviation.length((hi - lo).length());
+    let surface = Triangles::from_mesh(mesh);
+    let field = two_pole_field(&surface).map_err(SchemeError::Model)?;
+    let banded = strips_within(&surface, &field, tolerance).map_err(|e| {
+        SchemeError::Model(format!(
+            "no strips within {tolerance:.3} mm of the model: {e}; a larger --max-deviation may reach"
+        ))
+    })?;
+    let welded = Welded::new(&banded.strips).map_err(SchemeError::Model)?;
+    let names = |members: &[Vec<u32>]| welded.names(members);
+    let net = islands_along(
+        &welded.mesh,
+        &options.net,
+        &welded.folds,
+        &IslandNames::Own(&names),
+    );
+    let mut output = net.output;
+    let pieces = output.panels.len();
+    output.report = vec![format!(
+        "strip: {} strips in {pieces} pieces, at most {:.2} mm from the model both ways as measured (bound {:.2} mm); each piece unrolls exactly",
+        welded.strips, banded.deviation, tolerance
+    )];
+    output
+        .report
+        .extend(net.summary.report("strip pieces", "pieces"));
+    let mut section = net.summary.section("pieces");
+    section["strips"] = welded.strips.into();
+    section["max_deviation"] = round4(tolerance).into();
+    section["measured_deviation"] = round4(banded.deviation).into();
+    output.manifest.push("strip", section);
+    output.surface = Some(welded.mesh);
+    Ok(output)
+}
+
+/// True when triangle `t` has an area above rounding noise (its height more than a
+/// billionth of its longest side).
+fn has_area(t: [DVec3; 3]) -> bool {
+    let twice_area = (t[1] - t[0]).cross(t[2] - t[0]).length();
+    let longest = (0..3)
+        .map(|k| t[k].distance(t[(k + 1) % 3]))
+        .fold(0.0, f64::max);
+    twice_area > 2e-9 * longest * longest
+}
+
+/// The strips as one surface: a vertex per point they share (their curves' samples
+/// are the same points on both sides), a face per triangle, strip after strip.
+struct Welded {
+    mesh: Mesh,
+    /// The strip (from 0, counting strips with triangles) of each face.
+    strip_of_face: Vec<u32>,
+    /// The rungs between each strip's consecutive triangles, strip after strip.
+    folds: Vec<EdgeId>,
+    /// How many strips have triangles.
+    strips: u32,
+}
+
+impl Welded {
+    fn new(strips: &[Strip]) -> Result<Welded, String> {
+        let mut vertex: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut positions = Vec::new();
+        let mut faces: Vec<[u32; 3]> = Vec::new();
+        let mut strip_of_face = Vec::new();
+        let mut count = 0;
+        for strip in strips.iter().filter(|s| !s.triangles.is_empty()) {
+            let ids: Vec<u32> = strip
+                .points
+                .iter()
+                .map(|p| {
+                    *vertex
+                        .entry(p.to_array().map(f64::to_bits))
+                        .or_insert_with(|| {
+                            positions.push(*p);
+                            positions.len() as u32 - 1
+                        })
+                })
+                .collect();
+            for t in &strip.triangles {
+                // A triangle whose corners weld together or lie on a line (where two
+                // curves touch) covers nothing; its strip goes on from the next one.
+                if !has_area(t.map(|i| strip.points[i as usize])) {
+                    continue;
+                }
+                faces.push(t.map(|i| ids[i as usize]));
+                strip_of_face.push(count);
+            }
+            count += 1;
+        }
+        let mesh = crate::mesh::build::build_from_faces(positions, &faces).map_err(|e| {
+            format!(
+                "the strips do not join into one surface ({e}); a different --max-deviation may"
+            )
+        })?;
+        let mut folds = Vec::new();
+        for f in 1..faces.len() {
+            if strip_of_face[f] != strip_of_face[f - 1] {
+                continue;
+            }
+            let shared = mesh
+                .face_half_edges(FaceId(f as u32 - 1))
+                .find(|h| mesh.face(h.twin()) == Some(FaceId(f as u32)));
+            folds.extend(shared.map(|h| h.edge()));
+        }
+        Ok(Welded {
+            mesh,
+            strip_of_face,
+            folds,
+            strips: count,
+        })
+    }
+
+    /// The pieces' names: `S<strip>.<piece>` along each strip, `S<strip>` for a strip
+    /// in one piece (`members` in the order of their lowest face: along the strips).
+    fn names(&self, members: &[Vec<u32>]) -> Vec<Name> {
+        let strip = |faces: &Vec<u32>| self.strip_of_face[faces[0] as usize];
+        let mut pieces = vec![0u32; self.strips as usize];
+        for faces in members {
+            pieces[strip(faces) as usize] += 1;
+        }
+        let mut seen = vec![0u32; self.strips as usize];
+        members
+            .iter()
+            .map(|faces| {
+                let s = strip(faces) as usize;
+                seen[s] += 1;
+                match pieces[s] {
+                    1 => Name::new(&STRIP, s as u32 + 1),
+                    _ => Name::with_part(&STRIP, s as u32 + 1, seen[s]),
+                }
+            })
+            .collect()
+    }
+}
 
 /// A surface as triangles over shared corners, counter-clockwise seen from outside.
 #[derive(Clone, Debug, PartialEq)]
@@ -1154,7 +1487,7 @@ fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
 /// one, 1 at the other, the cotangent Laplacian's zero elsewhere; faer's sparse
 /// Cholesky): level curves that run round the part like parallels between its ends,
 /// with saddles only where its shape needs them. The poles are the part's two points
-/// farthest apart or, on a part with rims, the rims nearest them (an open tube's
+/// farthest apart or, on a part with rims, its rims ([`pole_values`]; an open tube's
 /// levels then run parallel to its rims).
 pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
     let n = surface.points.len();
@@ -1210,31 +1543,52 @@ pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
     Ok(field)
 }
 
-/// The field's fixed values on `part`: 0 and 1 at its two points farthest apart, or on
-/// the rims nearest them where those are two different rims.
+/// The field's fixed values on `part`: 0 and 1 at its two points farthest apart on a
+/// closed part; on a part with one rim, 0 on it and 1 at the point farthest from it;
+/// with more, 0 and 1 on the two rims whose centres lie farthest apart.
 fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u32, f64> {
-    let [one, other] = poles(points, part);
     let in_part: Vec<&Vec<u32>> = rims
         .iter()
         .filter(|r| part.binary_search(&r[0]).is_ok())
         .collect();
-    let nearest = |pole: u32| {
-        in_part.iter().copied().min_by(|a, b| {
-            let d = |r: &Vec<u32>| {
-                r.iter()
-                    .map(|&v| points[v as usize].distance(points[pole as usize]))
+    let at = |v: u32| points[v as usize];
+    let held = |zero: &[u32], one: &[u32]| -> BTreeMap<u32, f64> {
+        let zeros = zero.iter().map(|&v| (v, 0.0));
+        zeros.chain(one.iter().map(|&v| (v, 1.0))).collect()
+    };
+    match in_part.as_slice() {
+        [] => {
+            let [one, other] = poles(points, part);
+            held(&[one], &[other])
+        }
+        // One rim: from it to the point farthest from it.
+        [rim] => {
+            let from_rim = |v: u32| {
+                rim.iter()
+                    .map(|&r| at(r).distance(at(v)))
                     .fold(f64::INFINITY, f64::min)
             };
-            d(a).total_cmp(&d(b))
-        })
-    };
-    match (nearest(one), nearest(other)) {
-        (Some(a), Some(b)) if a != b => a
-            .iter()
-            .map(|&v| (v, 0.0))
-            .chain(b.iter().map(|&v| (v, 1.0)))
-            .collect(),
-        _ => BTreeMap::from([(one, 0.0), (other, 1.0)]),
+            let far = part
+                .iter()
+                .copied()
+                .max_by(|&a, &b| from_rim(a).total_cmp(&from_rim(b)).then(b.cmp(&a)))
+                .unwrap_or(part[0]);
+            held(rim, &[far])
+        }
+        // Several rims: the two whose centres lie farthest apart (an open tube's ends).
+        rims => {
+            let centre = |r: &[u32]| r.iter().map(|&v| at(v)).sum::<DVec3>() / r.len() as f64;
+            let mut best = (0, 1, f64::NEG_INFINITY);
+            for i in 0..rims.len() {
+                for j in i + 1..rims.len() {
+                    let d = centre(rims[i]).distance(centre(rims[j]));
+                    if d > best.2 {
+                        best = (i, j, d);
+                    }
+                }
+            }
+            held(rims[best.0], rims[best.1])
+        }
     }
 }
 

@@ -916,3 +916,38 @@ pub fn flat_grid_obj(n: usize) -> String {
     }
     obj
 }
+
+/// The mesh a job's scheme would build, written as an OBJ.
+pub fn write_obj(mesh: &Mesh, path: &Path) {
+    let mut text = String::new();
+    for p in mesh.positions() {
+        text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for f in mesh.faces() {
+        let corners: Vec<String> = mesh
+            .face_vertices(f)
+            .map(|v| (v.0 + 1).to_string())
+            .collect();
+        text.push_str(&format!("f {}\n", corners.join(" ")));
+    }
+    std::fs::write(path, text).unwrap();
+}
+
+/// `model` simplified to `edges` edges (its holes filled when `fill_holes`), as the
+/// half-edge scheme builds it, written to `dir` as an OBJ: a test that builds one model
+/// with many schemes or sizes simplifies it once.
+pub fn simplified_obj(model: &Path, edges: usize, fill_holes: bool, dir: &Path) -> PathBuf {
+    let mut o = options("half-edge", "1ft", 0, &dir.join("unused"));
+    o.model.target_edges = Some(unfold::config::TargetEdges::Count(edges));
+    o.model.fill_holes = fill_holes;
+    let job = resolve(o, model);
+    let loaded = unfold::run::load(&job).expect("loads");
+    let prepared = unfold::run::prepare(&job, loaded).expect("prepares");
+    let stem = model.file_stem().unwrap().to_string_lossy();
+    let path = dir.join(format!(
+        "{stem}-{edges}{}.obj",
+        if fill_holes { "-filled" } else { "" }
+    ));
+    write_obj(&prepared.scheme_mesh.mesh, &path);
+    path
+}

@@ -1,0 +1,430 @@
+//! End-to-end tests of the strip scheme (SPEC.md §2, strip): strips without an interior
+//! vertex that unroll exactly, within `--max-deviation` of the model both ways (sampled
+//! here, with exact point–triangle distances of the test's own), welded along their
+//! shared curves into one surface, pieces named by strip and piece that fit the sheet
+//! and pass the independent sheet check, the same bytes on one and two threads.
+
+use crate::common;
+
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::f64::consts::TAU;
+use std::path::{Path, PathBuf};
+
+use glam::DVec3;
+use serde_json::Value;
+use tempfile::TempDir;
+
+use common::build::*;
+use unfold::mesh::{FaceId, Mesh};
+
+/// An OBJ of `points` and `faces` (0-based), written to `dir/name.obj`.
+fn write_model(dir: &Path, name: &str, points: &[DVec3], faces: &[Vec<u32>]) -> PathBuf {
+    let mut text = String::new();
+    for p in points {
+        text.push_str(&format!("v {} {} {}\n", p.x, p.y, p.z));
+    }
+    for f in faces {
+        let ids: Vec<String> = f.iter().map(|i| (i + 1).to_string()).collect();
+        text.push_str(&format!("f {}\n", ids.join(" ")));
+    }
+    let path = dir.join(format!("{name}.obj"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A surface of revolution about z: `around` × `along` quads through the profile
+/// points (radius, height), open at its ends unless a profile point has radius 0 (a
+/// pole, closed by triangles).
+fn revolved(dir: &Path, name: &str, profile: &[(f64, f64)], around: usize) -> PathBuf {
+    let mut points = Vec::new();
+    let mut first = Vec::new();
+    for &(r, z) in profile {
+        first.push(points.len() as u32);
+        let ring = if r == 0.0 { 1 } else { around };
+        for i in 0..ring {
+            let a = TAU * i as f64 / around as f64;
+            points.push(DVec3::new(r * a.cos(), r * a.sin(), z));
+        }
+    }
+    let at = |k: usize, i: usize| {
+        let ring = if profile[k].0 == 0.0 { 1 } else { around };
+        first[k] + (i % around % ring) as u32
+    };
+    let mut faces = Vec::new();
+    for k in 0..profile.len() - 1 {
+        for i in 0..around {
+            // Counter-clockwise seen from outside, the profile running upward.
+            let quad = [at(k, i), at(k, i + 1), at(k + 1, i + 1), at(k + 1, i)];
+            let mut face: Vec<u32> = Vec::new();
+            for v in quad {
+                if !face.contains(&v) {
+                    face.push(v);
+                }
+            }
+            faces.push(face);
+        }
+    }
+    write_model(dir, name, &points, &faces)
+}
+
+/// A torus of radii `big` and `small` in `around` × `across` quads.
+fn torus(dir: &Path, around: usize, across: usize, big: f64, small: f64) -> PathBuf {
+    let mut points = Vec::new();
+    for i in 0..around {
+        let a = TAU * i as f64 / around as f64;
+        for j in 0..across {
+            let b = TAU * j as f64 / across as f64;
+            let r = big + small * b.cos();
+            points.push(DVec3::new(r * a.cos(), r * a.sin(), small * b.sin()));
+        }
+    }
+    let at = |i: usize, j: usize| ((i % around) * across + j % across) as u32;
+    let mut faces = Vec::new();
+    for i in 0..around {
+        for j in 0..across {
+            faces.push(vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    write_model(dir, "torus", &points, &faces)
+}
+
+/// A sphere's profile: `rings` steps from the south pole to the north.
+fn sphere_profile(radius: f64, rings: usize) -> Vec<(f64, f64)> {
+    (0..=rings)
+        .map(|k| {
+            let polar = std::f64::consts::PI * k as f64 / rings as f64;
+            let r = radius * polar.sin();
+            (
+                if k == 0 || k == rings { 0.0 } else { r },
+                -radius * polar.cos(),
+            )
+        })
+        .collect()
+}
+
+/// The closest point to `p` on triangle `abc` (by its Voronoi regions: corners, then
+/// sides, then the inside).
+fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    a + ab * (vb * denom) + ac * (vc * denom)
+}
+
+/// The triangles of a mesh (faces fanned from their first corner).
+fn triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
+    let mut out = Vec::new();
+    for f in mesh.faces() {
+        let p: Vec<DVec3> = mesh.face_positions(f).collect();
+        for k in 1..p.len() - 1 {
+            out.push([p[0], p[k], p[k + 1]]);
+        }
+    }
+    out
+}
+
+/// The largest distance from points of `from` (each triangle sampled on a grid of
+/// about `spacing`, corners included) to the nearest triangle of `to`, searched among
+/// the triangles whose box comes within `reach` (beyond it, `reach` is returned).
+fn one_way(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64, reach: f64) -> f64 {
+    let cell = reach.max(1e-6);
+    let key = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
+    let mut grid: HashMap<[i32; 3], Vec<usize>> = HashMap::new();
+    for (t, tri) in to.iter().enumerate() {
+        let lo = tri[0].min(tri[1]).min(tri[2]) - DVec3::splat(reach);
+        let hi = tri[0].max(tri[1]).max(tri[2]) + DVec3::splat(reach);
+        let (a, b) = (key(lo), key(hi));
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    grid.entry([x, y, z]).or_default().push(t);
+                }
+            }
+        }
+    }
+    let mut worst: f64 = 0.0;
+    for tri in from {
+        let longest = (0..3)
+            .map(|k| tri[k].distance(tri[(k + 1) % 3]))
+            .fold(0.0, f64::max);
+        let n = (longest / spacing).ceil().max(1.0) as usize;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, v) = (i as f64 / n as f64, j as f64 / n as f64);
+                let p = tri[0] + (tri[1] - tri[0]) * u + (tri[2] - tri[0]) * v;
+                let d = grid.get(&key(p)).map_or(reach, |near| {
+                    near.iter()
+                        .map(|&t| closest_on_triangle(p, to[t]).distance(p))
+                        .fold(reach, f64::min)
+                });
+                worst = worst.max(d);
+            }
+        }
+    }
+    worst
+}
+
+/// Checks the strip facts of one build through the library: every piece and every
+/// strip without an interior vertex, the strips' surface within `bound` of the model
+/// both ways, closed where the model is closed, each strip's pieces a run of it; the
+/// flat pieces keep their edge lengths. Returns (strips, pieces).
+fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, usize) {
+    let p = pipeline(job);
+    let surface = p.output.surface.as_ref().expect("the strips' surface");
+    let size = {
+        let (lo, hi) = surface
+            .positions()
+            .iter()
+            .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
+                (lo.min(q), hi.max(q))
+            });
+        (hi - lo).max_element()
+    };
+    // Pieces by strip; every face in one piece.
+    let mut strips: BTreeMap<u32, Vec<&[u32]>> = BTreeMap::new();
+    let mut covered = BTreeSet::new();
+    for (panel, group) in p.panels.iter().zip(&p.output.face_groups) {
+        let id = panel.id();
+        assert_eq!(id.to_string().chars().next(), Some('S'), "{what}: {id}");
+        strips.entry(id.number).or_default().push(&group.faces);
+        for &f in &group.faces {
+            assert!(covered.insert(f), "{what}: face {f} in two pieces");
+        }
+    }
+    assert_eq!(
+        covered.len(),
+        surface.face_count(),
+        "{what}: faces in pieces"
+    );
+    for (strip, pieces) in &strips {
+        let all: Vec<u32> = pieces.iter().flat_map(|f| f.iter().copied()).collect();
+        assert_no_interior_vertex(what, &format!("S{strip}"), surface, &all);
+        for faces in pieces {
+            assert_no_interior_vertex(what, &format!("a piece of S{strip}"), surface, faces);
+        }
+        // A strip's faces are numbered along it: its pieces are runs.
+        let mut sorted = all.clone();
+        sorted.sort_unstable();
+        assert!(
+            sorted.windows(2).all(|w| w[1] == w[0] + 1),
+            "{what}: S{strip} is not one run of faces"
+        );
+    }
+    // Welded along shared curves: closed where the model is.
+    assert_eq!(
+        surface.boundary_loops().is_empty(),
+        p.mesh.boundary_loops().is_empty(),
+        "{what}: the strips' surface is closed where the model is"
+    );
+    for flat in &p.flat {
+        assert!(
+            flat.developability_error <= 1e-9 * size,
+            "{what}: {} unrolls with error {}",
+            flat.source.id,
+            flat.developability_error
+        );
+    }
+    let (model, strip) = (triangles(&p.mesh), triangles(surface));
+    let spacing = bound / 4.0;
+    let out = one_way(&strip, &model, spacing, 2.0 * bound);
+    let back = one_way(&model, &strip, spacing, 2.0 * bound);
+    eprintln!(
+        "{what}: {} strips in {} pieces, {out:.3} mm out and {back:.3} mm back (bound {bound:.3} mm)",
+        strips.len(),
+        p.panels.len()
+    );
+    assert!(
+        out <= bound * (1.0 + 1e-9),
+        "{what}: strips {out} mm from the model"
+    );
+    assert!(
+        back <= bound * (1.0 + 1e-9),
+        "{what}: model {back} mm from the strips"
+    );
+    (strips.len(), p.panels.len())
+}
+
+/// Every corner of `faces` (of `surface`, numbered along their strip) lies on their
+/// outline as cut: an edge not joining two consecutive faces (a rung joins them; a
+/// strip that runs on both sides of a slit, where two curves touch, is cut along it).
+fn assert_no_interior_vertex(what: &str, name: &str, surface: &Mesh, faces: &[u32]) {
+    let mut users: BTreeMap<(u32, u32), Vec<u32>> = BTreeMap::new();
+    let mut corners = BTreeSet::new();
+    for &f in faces {
+        let v: Vec<u32> = surface.face_vertices(FaceId(f)).map(|v| v.0).collect();
+        for k in 0..v.len() {
+            let (a, b) = (v[k], v[(k + 1) % v.len()]);
+            users.entry((a.min(b), a.max(b))).or_default().push(f);
+            corners.insert(a);
+        }
+    }
+    let rung = |f: &[u32]| f.len() == 2 && f[0].abs_diff(f[1]) == 1;
+    let on_outline: BTreeSet<u32> = users
+        .iter()
+        .filter(|(_, f)| !rung(f))
+        .flat_map(|(&(a, b), _)| [a, b])
+        .collect();
+    let inside: Vec<&u32> = corners.difference(&on_outline).collect();
+    assert!(
+        inside.is_empty(),
+        "{what}: {name} has interior vertices {inside:?}"
+    );
+}
+
+/// The job of `unfold MODEL --scheme strip --size SIZE --max-deviation DEVIATION`.
+fn strip_job(model: &Path, size: &str, deviation: &str, out: &Path) -> unfold::config::Job {
+    let mut o = options("strip", size, 0, out);
+    o.scheme_values.set("max-deviation", deviation);
+    resolve(o, model)
+}
+
+/// Builds from the command line with `--format svg,dxf` and checks every sheet.
+fn strip_build(model: &Path, size: &str, deviation: &str, out: &Path) -> Value {
+    let args = ["--format", "svg,dxf", "--max-deviation", deviation];
+    let m = build("strip", model, size, out, &args);
+    let name = model.file_stem().unwrap().to_string_lossy().into_owned();
+    check_output(model, out, &m, &name, DxfCheck::FirstAndLast, |e| {
+        e["id"].as_str().unwrap().to_string()
+    });
+    m
+}
+
+#[test]
+fn an_open_cylinder_is_one_strip_in_one_piece() {
+    let tmp = TempDir::new().unwrap();
+    let profile: Vec<(f64, f64)> = (0..=4).map(|k| (50.0, 25.0 * k as f64)).collect();
+    let model = revolved(tmp.path(), "cylinder", &profile, 32);
+    let job = strip_job(&model, "100mm", "0.5mm", &tmp.path().join("job"));
+    assert_eq!(check_strips("cylinder", &job, 0.5), (1, 1));
+    let m = strip_build(&model, "100mm", "0.5mm", &tmp.path().join("out"));
+    assert_eq!(count(&m, "strip.strips"), 1);
+    assert_eq!(count(&m, "strip.pieces"), 1);
+    let ids: Vec<&str> = m["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["id"].as_str().unwrap())
+        .collect();
+    assert_eq!(ids, ["S1"]);
+    assert!(num(&m, "strip.measured_deviation") <= 0.5);
+}
+
+#[test]
+fn cones_spheres_and_tori_are_strips_within_the_bound() {
+    let tmp = TempDir::new().unwrap();
+    let cone: Vec<(f64, f64)> = (0..=6)
+        .map(|k| (60.0 - 7.0 * k as f64, 15.0 * k as f64))
+        .collect();
+    let models = [
+        ("cone", revolved(tmp.path(), "cone", &cone, 32), "1%"),
+        (
+            "sphere",
+            revolved(tmp.path(), "sphere", &sphere_profile(100.0, 16), 32),
+            "1%",
+        ),
+        ("torus", torus(tmp.path(), 32, 16, 80.0, 30.0), "1%"),
+    ];
+    for (name, model, deviation) in &models {
+        let job = strip_job(model, "200mm", deviation, &tmp.path().join("job"));
+        let (lo, hi) = {
+            let p = pipeline(&job);
+            let pts = p.mesh.positions();
+            pts.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
+                (lo.min(q), hi.max(q))
+            })
+        };
+        let bound = 0.01 * (hi - lo).length();
+        let (strips, pieces) = check_strips(name, &job, bound);
+        // An open cone unrolls whole, rim to rim; a sphere or a torus takes several.
+        let least = if *name == "cone" { 1 } else { 2 };
+        assert!(
+            strips >= least && pieces >= strips,
+            "{name}: {strips} strips, {pieces} pieces"
+        );
+        if *name == "cone" {
+            assert_eq!(strips, 1, "an open cone is one strip");
+        }
+        let m = strip_build(model, "200mm", deviation, &tmp.path().join(name));
+        assert_eq!(count(&m, "strip.strips"), strips, "{name}");
+        assert!(num(&m, "strip.measured_deviation") <= bound, "{name}");
+    }
+}
+
+#[test]
+fn the_bunny_is_strips_within_the_bound() {
+    let Some(shared) = shared_models("the_bunny_is_strips_within_the_bound") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let bunny = simplified_obj(&shared.join("stanford-bunny.obj"), 2000, true, tmp.path());
+    let job = strip_job(&bunny, "2ft", "1%", &tmp.path().join("job"));
+    let p = pipeline(&job);
+    let pts = p.mesh.positions();
+    let (lo, hi) = pts.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
+        (lo.min(q), hi.max(q))
+    });
+    check_strips("bunny", &job, 0.01 * (hi - lo).length());
+    strip_build(&bunny, "2ft", "1%", &tmp.path().join("out"));
+}
+
+#[test]
+fn strips_are_the_same_bytes_on_one_and_two_threads() {
+    let tmp = TempDir::new().unwrap();
+    let model = torus(tmp.path(), 24, 12, 80.0, 30.0);
+    assert_same_bytes_on_one_and_two_threads(
+        &model,
+        &[
+            "--scheme",
+            "strip",
+            "--size",
+            "200mm",
+            "--max-deviation",
+            "1%",
+        ],
+    );
+}
+
+#[test]
+fn a_bound_of_zero_or_below_is_a_usage_error() {
+    for bad in ["0mm", "-1%", "0%", "abc", "5"] {
+        let tmp = TempDir::new().unwrap();
+        let flag = format!("--max-deviation={bad}");
+        let run = unfold([
+            model("torus-8x6").to_str().unwrap(),
+            "--scheme",
+            "strip",
+            "--size",
+            "200mm",
+            &flag,
+            "--out",
+            tmp.path().join("out").to_str().unwrap(),
+        ]);
+        assert_refusal(bad, &run, 2, &["--max-deviation"]);
+        assert!(!tmp.path().join("out").exists(), "{bad}: nothing written");
+    }
+}
