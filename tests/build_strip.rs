@@ -381,7 +381,7 @@ fn the_bunny_is_strips_within_the_bound() {
         return;
     };
     let tmp = TempDir::new().unwrap();
-    let bunny = simplified_obj(&shared.join("stanford-bunny.obj"), 2000, true, tmp.path());
+    let bunny = simplified_obj(&shared.join("stanford-bunny.obj"), 1500, true, tmp.path());
     let job = strip_job(&bunny, "2ft", "1%", &tmp.path().join("job"));
     let p = pipeline(&job);
     let pts = p.mesh.positions();

@@ -209,16 +209,19 @@ fn a_model_too_detailed_for_its_size_gets_a_budget_that_builds() {
                 "--build-anyway builds it as it is",
             ],
         );
-        // The search runs two trials at a time; on one thread it names the same.
-        let one_thread = finish(
-            unfold_command()
-                .arg(&spot)
-                .arg("--out")
-                .arg(&out)
-                .args(args)
-                .env("RAYON_NUM_THREADS", "1"),
-        );
-        assert_eq!(one_thread.stderr, run.stderr, "{scheme} on one thread");
+        // The search runs two trials at a time; on one thread it names the same (the
+        // search is the same code for every scheme: checked on one).
+        if scheme == "quad-edge" {
+            let one_thread = finish(
+                unfold_command()
+                    .arg(&spot)
+                    .arg("--out")
+                    .arg(&out)
+                    .args(args)
+                    .env("RAYON_NUM_THREADS", "1"),
+            );
+            assert_eq!(one_thread.stderr, run.stderr, "{scheme} on one thread");
+        }
         let budget_edges = number_after(&run.stderr, "--target-edges ").unwrap();
         let budget = budget_edges.to_string();
         assert!(

@@ -110,7 +110,7 @@ fn every_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
                 }
                 // Strips on faceted models: a bound the sweep reaches in a second.
                 if **scheme == "strip" {
-                    cmd.args(["--max-deviation", "2%"]);
+                    cmd.args(["--max-deviation", "5%"]);
                 }
                 let started = std::time::Instant::now();
                 let run = finish(&mut cmd);

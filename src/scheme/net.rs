@@ -900,6 +900,7 @@ fn place_tabs(
     islands: &Islands,
     cuts: &[EdgeId],
     options: &NetOptions,
+    first: &dyn Fn(EdgeId) -> bool,
 ) -> Vec<Option<Tab>> {
     let mut placed: Vec<Option<Tab>> = (0..mesh.edge_count()).map(|_| None).collect();
     // Tabs already placed, per island: (owner face, flat outline); and the hulls.
@@ -907,8 +908,7 @@ fn place_tabs(
     let mut hulls: Vec<Vec<DVec2>> = islands.hull.clone();
     for &e in cuts {
         let h = e.half_edge();
-        // Even edges try the face of half-edge 2e first, odd ones the other.
-        let sides = if e.0.is_multiple_of(2) {
+        let sides = if first(e) {
             [h, h.twin()]
         } else {
             [h.twin(), h]
@@ -991,9 +991,18 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
 pub enum IslandNames<'a> {
     /// `N1`, `N2`, … in the order of their lowest face; each covers its faces.
     Numbered,
-    /// Named by the scheme from every island's faces (in the order of their lowest
+    /// Named by the scheme ([`OwnNet`]).
+    Own(OwnNet<'a>),
+}
+
+/// What a scheme that grows a net its own way says of its islands and tabs.
+pub struct OwnNet<'a> {
+    /// The islands' names from every island's faces (in the order of their lowest
     /// face, each list increasing).
-    Own(&'a dyn Fn(&[Vec<u32>]) -> Vec<Name>),
+    pub names: &'a dyn Fn(&[Vec<u32>]) -> Vec<Name>,
+    /// True when the face of half-edge `h` is to own its edge's tab, rather than the
+    /// face across (that side is tried first).
+    pub tab_first: &'a dyn Fn(HalfedgeId) -> bool,
 }
 
 /// A net and what its report says of it.
@@ -1050,7 +1059,12 @@ fn island_net(
         .collect::<std::collections::BTreeSet<_>>()
         .into_iter()
         .collect();
-    let tabs = place_tabs(mesh, &islands, &cuts, options);
+    let first = |e: EdgeId| match names {
+        // Even edges try the face of half-edge 2e first, odd ones the other.
+        IslandNames::Numbered => e.0.is_multiple_of(2),
+        IslandNames::Own(own) => (own.tab_first)(e.half_edge()),
+    };
+    let tabs = place_tabs(mesh, &islands, &cuts, options, &first);
 
     // Islands in the order of their lowest face, numbered from 1.
     let mut members: Vec<Vec<u32>> = islands
@@ -1068,7 +1082,7 @@ fn island_net(
         IslandNames::Numbered => (1..=members.len() as u32)
             .map(|k| Name::new(&ISLAND, k))
             .collect(),
-        IslandNames::Own(name) => name(&members),
+        IslandNames::Own(own) => (own.names)(&members),
     };
     let mut number = vec![0u32; mesh.face_count()];
     let mut facet_of = vec![0u32; mesh.face_count()];

@@ -19,12 +19,12 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
-use super::net::{islands_along, FlatFoldArgs, IslandNames, NetOptions, FLAT_FOLD_DEG};
+use super::net::{islands_along, FlatFoldArgs, IslandNames, NetOptions, OwnNet, FLAT_FOLD_DEG};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{Scheme, SchemeError, SchemeOutput};
 use crate::mesh::distance::TriangleGrid;
 use crate::mesh::soup::{find, union};
-use crate::mesh::{EdgeId, FaceId, Mesh};
+use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::{IdKind, Name};
 use crate::record::{round4, Params};
@@ -215,7 +215,10 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
     let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
     let tolerance = options.max_deviation.length((hi - lo).length());
     let surface = Triangles::from_mesh(mesh);
-    let field = two_pole_field(&surface).map_err(SchemeError::Model)?;
+    let field = evened(
+        &surface,
+        &two_pole_field(&surface).map_err(SchemeError::Model)?,
+    );
     let banded = strips_within(&surface, &field, tolerance).map_err(|e| {
         SchemeError::Model(format!(
             "no strips within {tolerance:.3} mm of the model: {e}; a larger --max-deviation may reach"
@@ -223,11 +226,20 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
     })?;
     let welded = Welded::new(&banded.strips).map_err(SchemeError::Model)?;
     let names = |members: &[Vec<u32>]| welded.names(members);
+    // Each curve's tabs on the strip below it: the strip above is glued over them.
+    let tab_first = |h: HalfedgeId| {
+        let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
+        strip(h) <= strip(h.twin())
+    };
+    let own = OwnNet {
+        names: &names,
+        tab_first: &tab_first,
+    };
     let net = islands_along(
         &welded.mesh,
         &options.net,
         &welded.folds,
-        &IslandNames::Own(&names),
+        &IslandNames::Own(own),
     );
     let mut output = net.output;
     let pieces = output.panels.len();
@@ -1543,6 +1555,71 @@ pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
     Ok(field)
 }
 
+/// Bins of field values over which [`evened`] measures the surface's width per value.
+const EVEN_BINS: usize = 512;
+
+/// `field` remapped, by a function that only grows, so that equal steps of value are
+/// about equally wide on the surface: a band of values [v, v + dv] is dv / |∇f| wide
+/// where it crosses a triangle, and its width at v is the mean of that over the level
+/// set (each triangle's area in the band over its area times its gradient). A
+/// harmonic field crowds its levels near point poles; evened, bands split into equal
+/// parts split into strips of equal width. The level curves are the same curves.
+pub fn evened(surface: &Triangles, field: &[f64]) -> Vec<f64> {
+    let (lo, hi) = field
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
+        });
+    if hi.is_nan() || hi <= lo {
+        return field.to_vec();
+    }
+    let step = (hi - lo) / EVEN_BINS as f64;
+    let bin = |v: f64| (((v - lo) / step) as usize).min(EVEN_BINS - 1);
+    // Per bin: the area of the triangles in it, and that area times their gradient.
+    let mut area = vec![0.0; EVEN_BINS];
+    let mut area_gradient = vec![0.0; EVEN_BINS];
+    for t in &surface.corners {
+        let [a, b, c] = t.map(|i| surface.points[i as usize]);
+        let [fa, fb, fc] = t.map(|i| field[i as usize]);
+        let normal = (b - a).cross(c - a);
+        let twice = normal.length();
+        if twice <= 0.0 {
+            continue;
+        }
+        let n = normal / twice;
+        // ∇f = Σ f_i (n × e_i) / 2A, e_i the side opposite corner i, counter-clockwise.
+        let gradient = (fa * n.cross(c - b) + fb * n.cross(a - c) + fc * n.cross(b - a)) / twice;
+        let g = gradient.length();
+        let (first, last) = (bin(fa.min(fb).min(fc)), bin(fa.max(fb).max(fc)));
+        let share = 0.5 * twice / (last - first + 1) as f64;
+        for k in first..=last {
+            area[k] += share;
+            area_gradient[k] += share * g;
+        }
+    }
+    // Widths per unit of value; bins no triangle reaches keep a sliver of width, so the
+    // remap still grows there.
+    let widths: Vec<f64> = (0..EVEN_BINS)
+        .map(|k| match area_gradient[k] > 0.0 {
+            true => area[k] / area_gradient[k],
+            false => 0.0,
+        })
+        .collect();
+    let floor = 1e-6 * widths.iter().copied().fold(0.0, f64::max).max(1e-300);
+    let mut at = vec![0.0; EVEN_BINS + 1];
+    for k in 0..EVEN_BINS {
+        at[k + 1] = at[k] + step * widths[k].max(floor);
+    }
+    field
+        .iter()
+        .map(|&v| {
+            let k = bin(v);
+            let t = ((v - lo) / step - k as f64).clamp(0.0, 1.0);
+            at[k] + t * (at[k + 1] - at[k])
+        })
+        .collect()
+}
+
 /// The field's fixed values on `part`: 0 and 1 at its two points farthest apart on a
 /// closed part; on a part with one rim, 0 on it and 1 at the point farthest from it;
 /// with more, 0 and 1 on the two rims whose centres lie farthest apart.
@@ -1753,6 +1830,32 @@ mod tests {
         }
         uses.retain(|_, n| *n == 1);
         uses
+    }
+
+    /// The harmonic field of a wide cone between its rims crowds toward the narrow
+    /// rim (it goes as the log of the radius); evened, it runs evenly along the slant.
+    #[test]
+    fn an_evened_field_steps_evenly_along_the_surface() {
+        let cone = tube(48, 40, 100.0, |h| 10.0 + 1.5 * h);
+        let field = two_pole_field(&cone).unwrap();
+        let even = evened(&cone, &field);
+        let (lo, hi) = (
+            even.iter().copied().fold(f64::INFINITY, f64::min),
+            even.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        );
+        let mut worst_raw: f64 = 0.0;
+        let mut worst_even: f64 = 0.0;
+        for (k, p) in cone.points.iter().enumerate() {
+            let along = p.z / 100.0;
+            let raw = (field[k] - field[0]) / (field[field.len() - 1] - field[0]);
+            worst_raw = worst_raw.max((raw - along).abs());
+            worst_even = worst_even.max(((even[k] - lo) / (hi - lo) - along).abs());
+        }
+        assert!(
+            worst_raw > 0.2,
+            "the raw field is far from even: {worst_raw}"
+        );
+        assert!(worst_even < 0.02, "evened: {worst_even}");
     }
 
     #[test]
