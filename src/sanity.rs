@@ -163,8 +163,42 @@ pub fn check_labels(
         job.scheme.name(),
         left_out.partner
     );
+    if !job.scheme.panels_follow_faces() {
+        return panels_too_small(job, mesh, &what, &|output| ids_mostly_fit(job, output)).map(Some);
+    }
     let most = 2 * left_out.panel > panels;
     too_detailed(job, mesh, &what, most, budget).map(Some)
+}
+
+/// What a scheme that shapes its panels itself gets when they are too small: a
+/// warning (a refusal under `--strict`) naming the options that make them large
+/// enough for what `fits` asks, found by building them
+/// ([`crate::scheme::Configured::larger_panels`]), or its fix in words.
+fn panels_too_small(
+    job: &Job,
+    mesh: &Mesh,
+    what: &str,
+    fits: &dyn Fn(&SchemeOutput) -> bool,
+) -> Result<String> {
+    let fix = match job.scheme.larger_panels(mesh, fits) {
+        Some(options) => format!("{options} gives them room"),
+        None => format!("try {}", job.scheme.larger_panels_fix()),
+    };
+    let warning = format!(
+        "the {} panels are too small for this size: {what}; {fix}",
+        job.scheme.name()
+    );
+    strict(job, std::slice::from_ref(&warning))?;
+    Ok(warning)
+}
+
+/// Whether all but [`IDS_LEFT_OUT`] of the panels of `output`, unrolled, hold their id
+/// (what the label check asks).
+fn ids_mostly_fit(job: &Job, output: &SchemeOutput) -> bool {
+    let least_fold = job.scheme.least_scored_fold();
+    let panels = output.panels.len();
+    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), least_fold)
+        .is_ok_and(|(_, left_out)| left_out.panel as f64 <= IDS_LEFT_OUT * panels as f64)
 }
 
 /// Stops, before the scheme makes a panel, a model whose median edge is shorter than
@@ -240,16 +274,6 @@ fn too_detailed(
     most: bool,
     budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<String> {
-    // Panels the scheme shapes itself grow with its own options, not with a budget.
-    if !job.scheme.panels_follow_faces() {
-        let warning = format!(
-            "the {} panels are too small for this size: {what}; try {}",
-            job.scheme.name(),
-            job.scheme.larger_panels_fix()
-        );
-        strict(job, std::slice::from_ref(&warning))?;
-        return Ok(warning);
-    }
     let suggestion = budget();
     let fixes = detail_fixes(job, mesh, suggestion);
     if job.build_anyway || (job.model.budget.is_some() && !most) {
@@ -749,6 +773,10 @@ pub fn check_fasteners(
         let what = format!(
             "no {hole} fits at {n} of {connections} connections, their faces too small for it"
         );
+        if !job.scheme.panels_follow_faces() {
+            let fits = |output: &SchemeOutput| output.unfastened.is_empty();
+            return panels_too_small(job, mesh, &what, &fits).map(Some);
+        }
         return too_detailed(job, mesh, &what, 2 * n > connections, budget).map(Some);
     }
     let mut names: Vec<String> = bare.iter().take(NAMED).map(|c| c.to_string()).collect();

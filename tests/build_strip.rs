@@ -428,3 +428,57 @@ fn a_bound_of_zero_or_below_is_a_usage_error() {
         assert!(!tmp.path().join("out").exists(), "{bad}: nothing written");
     }
 }
+
+#[test]
+fn strips_too_narrow_for_their_ids_warn_with_a_bound_that_gives_them_room() {
+    let tmp = TempDir::new().unwrap();
+    let model = torus(tmp.path(), 48, 24, 80.0, 30.0);
+    let out = tmp.path().join("out");
+    let args = ["--scheme", "strip", "--size", "8in", "--quiet"];
+    // Warned (built), and refused under --strict with nothing written.
+    let run = unfold_command()
+        .arg(&model)
+        .args(args)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(0));
+    let manifest = read_manifest(&out);
+    let warning = manifest["warnings"][0]
+        .as_str()
+        .expect("a warning")
+        .to_string();
+    assert!(
+        warning.contains("strip panels have no room for their id"),
+        "{warning}"
+    );
+    let bound = warning
+        .split("--max-deviation ")
+        .nth(1)
+        .and_then(|rest| rest.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no bound named: {warning}"))
+        .to_string();
+    let strict = tmp.path().join("strict");
+    let strict_run = |extra: &[&str]| {
+        let mut cmd = unfold_command();
+        cmd.arg(&model).args(args).args(extra);
+        finish(cmd.arg("--strict").arg("--out").arg(&strict))
+    };
+    let run = strict_run(&[]);
+    assert_refusal(
+        "--strict",
+        &run,
+        2,
+        &["--max-deviation", "refused by --strict"],
+    );
+    assert!(!strict.exists(), "nothing written");
+    // The bound named builds clean under --strict.
+    let run = strict_run(&["--max-deviation", &bound]);
+    assert_eq!(run.code, Some(0), "--max-deviation {bound}: {}", run.stderr);
+    assert_eq!(
+        count(&read_manifest(&strict), "counts.panel_ids_left_out"),
+        0,
+        "--max-deviation {bound}"
+    );
+}

@@ -95,6 +95,13 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     fn larger_panels_fix(&self) -> &'static str {
         "a larger --size"
     }
+    /// For a scheme whose panels do not follow the faces: its options that make the
+    /// panels of `mesh` large enough for what `fits` asks (their ids, their
+    /// fasteners), found by building them, as the command line writes them
+    /// ("--max-deviation 2%"); `None` where none it tries does.
+    fn larger_panels(&self, _mesh: &Mesh, _fits: &dyn Fn(&SchemeOutput) -> bool) -> Option<String> {
+        None
+    }
 }
 
 /// The concrete options behind a [`Configured`], for callers that know their type
@@ -383,6 +390,15 @@ impl ConfiguredScheme {
     /// What makes its panels larger ([`Configured::larger_panels_fix`]).
     pub fn larger_panels_fix(&self) -> &'static str {
         self.options.larger_panels_fix()
+    }
+
+    /// Its options that make its panels large enough ([`Configured::larger_panels`]).
+    pub fn larger_panels(
+        &self,
+        mesh: &Mesh,
+        fits: &dyn Fn(&SchemeOutput) -> bool,
+    ) -> Option<String> {
+        self.options.larger_panels(mesh, fits)
     }
 
     /// The manifest's `scheme.params`: the shared options, then the scheme's own.

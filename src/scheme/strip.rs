@@ -93,11 +93,29 @@ impl Deviation {
         Ok(deviation)
     }
 
+    /// This bound `k` times over.
+    fn times(self, k: f64) -> Deviation {
+        match self {
+            Deviation::Length(mm) => Deviation::Length(k * mm),
+            Deviation::Fraction(f) => Deviation::Fraction(k * f),
+        }
+    }
+
     /// The distance (mm) for a model of bounding-box diagonal `diagonal` (mm).
     pub fn length(self, diagonal: f64) -> f64 {
         match self {
             Deviation::Length(mm) => mm,
             Deviation::Fraction(f) => f * diagonal,
+        }
+    }
+}
+
+/// As `--max-deviation` takes it: `2.5mm` or `1%`.
+impl std::fmt::Display for Deviation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Deviation::Length(mm) => write!(f, "{}mm", round4(mm)),
+            Deviation::Fraction(x) => write!(f, "{}%", round4(100.0 * x)),
         }
     }
 }
@@ -188,9 +206,7 @@ impl Configured for StripOptions {
         params.push("flat_fold_deg", round4(self.net.flat_fold.to_degrees()));
         match self.max_deviation {
             Deviation::Length(mm) => params.push("max_deviation", round4(mm)),
-            Deviation::Fraction(f) => {
-                params.push("max_deviation", format!("{}%", round4(100.0 * f)))
-            }
+            fraction => params.push("max_deviation", fraction.to_string()),
         }
         params
     }
@@ -206,6 +222,19 @@ impl Configured for StripOptions {
 
     fn larger_panels_fix(&self) -> &'static str {
         "a larger --max-deviation (wider strips) or a larger --size"
+    }
+
+    fn larger_panels(&self, mesh: &Mesh, fits: &dyn Fn(&SchemeOutput) -> bool) -> Option<String> {
+        // Strips widen about as the root of the bound: doubling it three times makes
+        // them nearly three times wider.
+        [2.0, 4.0, 8.0].into_iter().find_map(|k| {
+            let wider = StripOptions {
+                max_deviation: self.max_deviation.times(k),
+                ..self.clone()
+            };
+            let output = strip_panels(mesh, &wider).ok()?;
+            fits(&output).then(|| format!("--max-deviation {}", wider.max_deviation))
+        })
     }
 }
 
