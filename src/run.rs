@@ -567,30 +567,7 @@ pub fn export(
         (lengths, laser),
         sheet_entries,
     );
-    files.push((
-        format!("{name}-assembled.obj"),
-        assembled_obj(&output.panels).into_bytes(),
-    ));
-    let map = job.map.then(|| {
-        let surface = crate::panel::surface::panel_surface(
-            output
-                .surface
-                .as_ref()
-                .unwrap_or(&prepared.scheme_mesh.mesh),
-            &output.panels,
-            &output.face_groups,
-        );
-        crate::export::map::assembly_map(&crate::export::map::MapInput {
-            surface: &surface,
-            panels: &output.panels,
-            layout,
-            name: &name,
-        })
-    });
-    let map = map.unwrap_or_default();
-    for (k, page) in map.iter().enumerate() {
-        files.push((map_file(&name, k), page.clone().into_bytes()));
-    }
+    let map = model_files(job, prepared, output, layout, &name, &mut files);
     manifest.warnings = warnings;
     if job.preview {
         let page = preview(job, layout, panels, &name, &manifest, &map);
@@ -605,6 +582,48 @@ pub fn export(
         .map_err(|e| Error::internal("writing the manifest", e))?;
     files.push((MANIFEST.into(), (json + "\n").into_bytes()));
     Ok(Exported { files, manifest })
+}
+
+/// The assembled model and the pages of the assembly map, added to `files`; returns
+/// the map's pages (none with `--no-map`).
+fn model_files(
+    job: &Job,
+    prepared: &Prepared,
+    output: &SchemeOutput,
+    layout: &Layout,
+    name: &str,
+    files: &mut Vec<(String, Vec<u8>)>,
+) -> Vec<String> {
+    // Where each panel sits on the model: for the map, and for the assembled model of
+    // a scheme that builds on a surface of its own (its pieces there, without tabs).
+    let surface = (job.map || output.surface.is_some()).then(|| {
+        crate::panel::surface::panel_surface(
+            output
+                .surface
+                .as_ref()
+                .unwrap_or(&prepared.scheme_mesh.mesh),
+            &output.panels,
+            &output.face_groups,
+        )
+    });
+    let assembled = match (&output.surface, &surface) {
+        (Some(_), Some(surface)) => crate::export::obj::surface_obj(&output.panels, surface),
+        _ => assembled_obj(&output.panels),
+    };
+    files.push((format!("{name}-assembled.obj"), assembled.into_bytes()));
+    let map = surface.as_ref().filter(|_| job.map).map(|surface| {
+        crate::export::map::assembly_map(&crate::export::map::MapInput {
+            surface,
+            panels: &output.panels,
+            layout,
+            name,
+        })
+    });
+    let map = map.unwrap_or_default();
+    for (k, page) in map.iter().enumerate() {
+        files.push((map_file(name, k), page.clone().into_bytes()));
+    }
+    map
 }
 
 /// The file of page `k` (from 0) of the assembly map: `NAME-map.svg`, then

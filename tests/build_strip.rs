@@ -351,13 +351,13 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
     ];
     for (name, model, deviation) in &models {
         let job = strip_job(model, "200mm", deviation, &tmp.path().join("job"));
-        let (lo, hi) = {
-            let p = pipeline(&job);
-            let pts = p.mesh.positions();
-            pts.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
+        let model_triangles = triangles(&pipeline(&job).mesh);
+        let (lo, hi) = model_triangles
+            .iter()
+            .flatten()
+            .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
                 (lo.min(q), hi.max(q))
-            })
-        };
+            });
         let bound = 0.01 * (hi - lo).length();
         let (strips, pieces) = check_strips(name, &job, bound);
         // An open cone unrolls whole, rim to rim; a sphere or a torus takes several.
@@ -369,9 +369,28 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
         if *name == "cone" {
             assert_eq!(strips, 1, "an open cone is one strip");
         }
-        let m = strip_build(model, "200mm", deviation, &tmp.path().join(name));
+        let out = tmp.path().join(name);
+        let m = strip_build(model, "200mm", deviation, &out);
         assert_eq!(count(&m, "strip.strips"), strips, "{name}");
         assert!(num(&m, "strip.measured_deviation") <= bound, "{name}");
+        // The assembled model is the strips' surface, without tabs: triangles only,
+        // within the bound of the model both ways (its numbers rounded to 1e-4 mm).
+        let (points, faces) = read_simple_obj(&out.join(format!("{name}-assembled.obj")));
+        assert!(
+            faces.iter().all(|f| f.len() == 3),
+            "{name}: a tab in the OBJ"
+        );
+        let assembled: Vec<[DVec3; 3]> = faces
+            .iter()
+            .map(|f| [points[f[0]], points[f[1]], points[f[2]]])
+            .collect();
+        let spacing = bound / 4.0;
+        let out_d = one_way(&assembled, &model_triangles, spacing, 2.0 * bound);
+        let back = one_way(&model_triangles, &assembled, spacing, 2.0 * bound);
+        assert!(
+            out_d.max(back) <= bound + 1e-3,
+            "{name}: OBJ {out_d} and {back} mm off"
+        );
     }
 }
 
