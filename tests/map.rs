@@ -17,7 +17,16 @@ use tempfile::TempDir;
 use unfold::mesh::{EdgeId, FaceId, Mesh};
 
 /// The faces a panel id stands for: a face panel's face, an edge panel's two faces.
-fn faces_of(mesh: &Mesh, id: &str) -> BTreeSet<u32> {
+fn faces_of(mesh: &Mesh, manifest: &Value, id: &str) -> BTreeSet<u32> {
+    // A panel that covers a group of faces lists them in the manifest.
+    let entry = manifest["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| p["id"] == id);
+    if let Some(faces) = entry.and_then(|p| p["source"]["faces"].as_array()) {
+        return faces.iter().map(|f| f.as_u64().unwrap() as u32).collect();
+    }
     let number: u32 = id[1..].parse().unwrap_or_else(|_| panic!("id {id}"));
     match &id[..1] {
         "F" => [number].into(),
@@ -79,7 +88,9 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
     let mut o = options(scheme, size, 0, &out);
     o.holes = None;
     o.model.target_edges = target_edges.map(unfold::config::TargetEdges::Count);
-    let mesh = common::build::pipeline(&resolve(o, model)).mesh;
+    // A scheme with a surface of its own (strips) is drawn, and its faces named, there.
+    let built = common::build::pipeline(&resolve(o, model));
+    let mesh = built.output.surface.unwrap_or(built.mesh);
 
     let mut named = BTreeSet::new();
     let mut checked = 0;
@@ -87,7 +98,7 @@ fn check_map(model: &Path, scheme: &str, size: &str, target_edges: Option<usize>
         for (id, at) in &view.ids {
             assert!(panel_ids.contains(id), "{}: {id} is no panel", view.name);
             let seen = face_seen(&mesh, view, *at);
-            let own = faces_of(&mesh, id);
+            let own = faces_of(&mesh, &manifest, id);
             assert!(
                 seen.is_some_and(|f| own.contains(&f)),
                 "{} view: {id} at {at} is drawn over face {seen:?}, not its own {own:?}",
@@ -173,6 +184,12 @@ fn every_panel_of_every_shared_model_is_on_the_map() {
             check_map(model, scheme, "4ft", Some(1000), args);
         }
     }
+}
+
+/// Strip pieces are drawn, and named, on the strips' own surface.
+#[test]
+fn strip_pieces_are_named_where_they_lie() {
+    check_map(&model("torus-8x6"), "strip", "12in", None, &[]);
 }
 
 /// On A4 the overview of the thesis bunny has room for about two thirds of its ids;
