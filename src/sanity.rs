@@ -195,10 +195,17 @@ fn panels_too_small(
 /// Whether all but [`IDS_LEFT_OUT`] of the panels of `output`, unrolled, hold their id
 /// (what the label check asks).
 fn ids_mostly_fit(job: &Job, output: &SchemeOutput) -> bool {
-    let least_fold = job.scheme.least_scored_fold();
     let panels = output.panels.len();
+    ids_left_out(job, output).is_some_and(|n| n as f64 <= IDS_LEFT_OUT * panels as f64)
+}
+
+/// How many panels of `output`, unrolled, have no room for their id (`None` when they
+/// do not unroll).
+fn ids_left_out(job: &Job, output: &SchemeOutput) -> Option<usize> {
+    let least_fold = job.scheme.least_scored_fold();
     crate::flatten::unroll_all(&output.panels, LabelOptions::default(), least_fold)
-        .is_ok_and(|(_, left_out)| left_out.panel as f64 <= IDS_LEFT_OUT * panels as f64)
+        .ok()
+        .map(|(_, left_out)| left_out.panel)
 }
 
 /// Stops, before the scheme makes a panel, a model whose median edge is shorter than
@@ -398,9 +405,7 @@ pub fn smallest_buildable_edge(job: &Job, mesh: &Mesh) -> Option<f64> {
 
 /// Whether every panel of `output`, unrolled, holds its id.
 fn ids_fit(job: &Job, output: &SchemeOutput) -> bool {
-    let least_fold = job.scheme.least_scored_fold();
-    crate::flatten::unroll_all(&output.panels, LabelOptions::default(), least_fold)
-        .is_ok_and(|(_, left_out)| left_out.panel == 0)
+    ids_left_out(job, output) == Some(0)
 }
 
 /// The smallest edge length (mm) at which the job's scheme, on a regular mesh of
