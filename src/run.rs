@@ -608,6 +608,9 @@ fn model_files(
     });
     let assembled = match (&output.surface, &surface) {
         (Some(_), Some(surface)) => crate::export::obj::surface_obj(&output.panels, surface),
+        _ if output.thickness > 0.0 => {
+            crate::export::obj::solid_obj(&output.panels, output.thickness)
+        }
         _ => assembled_obj(&output.panels),
     };
     files.push((format!("{name}-assembled.obj"), assembled.into_bytes()));

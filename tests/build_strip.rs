@@ -102,52 +102,6 @@ fn sphere_profile(radius: f64, rings: usize) -> Vec<(f64, f64)> {
         .collect()
 }
 
-/// The closest point to `p` on triangle `abc` (by its Voronoi regions: corners, then
-/// sides, then the inside).
-fn closest_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
-
-/// The triangles of a mesh (faces fanned from their first corner).
-fn triangles(mesh: &Mesh) -> Vec<[DVec3; 3]> {
-    let mut out = Vec::new();
-    for f in mesh.faces() {
-        let p: Vec<DVec3> = mesh.face_positions(f).collect();
-        for k in 1..p.len() - 1 {
-            out.push([p[0], p[k], p[k + 1]]);
-        }
-    }
-    out
-}
-
 /// The largest distance from points of `from` (each triangle sampled on a grid of
 /// about `spacing`, corners included) to the nearest triangle of `to`, searched among
 /// the triangles whose box comes within `reach` (beyond it, `reach` is returned).

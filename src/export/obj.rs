@@ -29,6 +29,53 @@ pub fn assembled_obj(panels: &Panels) -> String {
     out
 }
 
+/// The OBJ text of rigid panels `thickness` mm thick as they sit in the model: each a
+/// closed solid (its outer facet, the same moved inward, and the square-cut sides
+/// between), one object per panel.
+pub fn solid_obj(panels: &Panels, thickness: f64) -> String {
+    let mut out = format!("{} (mm)\n", super::folder::ASSEMBLED_HEADER);
+    let mut base = 1usize;
+    for panel in panels {
+        let _ = writeln!(out, "o {}", panel.id());
+        for facet in panel.facets {
+            let corners: Vec<glam::DVec3> =
+                facet.iter().map(|&i| panel.vertices[i as usize]).collect();
+            let normal = vector_area(&corners).normalize_or_zero();
+            let inner = corners.iter().map(|&p| p - thickness * normal);
+            for v in corners.iter().copied().chain(inner) {
+                let _ = writeln!(out, "v {} {} {}", fmt_mm(v.x), fmt_mm(v.y), fmt_mm(v.z));
+            }
+            let n = corners.len();
+            let outer: Vec<String> = (0..n).map(|k| (base + k).to_string()).collect();
+            let _ = writeln!(out, "f {}", outer.join(" "));
+            let inner: Vec<String> = (0..n).rev().map(|k| (base + n + k).to_string()).collect();
+            let _ = writeln!(out, "f {}", inner.join(" "));
+            for k in 0..n {
+                let j = (k + 1) % n;
+                let _ = writeln!(
+                    out,
+                    "f {} {} {} {}",
+                    base + j,
+                    base + k,
+                    base + n + k,
+                    base + n + j
+                );
+            }
+            base += 2 * n;
+        }
+    }
+    out
+}
+
+/// The vector area of a planar loop (its normal times its area).
+fn vector_area(corners: &[glam::DVec3]) -> glam::DVec3 {
+    let n = corners.len();
+    (0..n)
+        .map(|k| corners[k].cross(corners[(k + 1) % n]))
+        .sum::<glam::DVec3>()
+        * 0.5
+}
+
 /// The OBJ text of a scheme's own surface (the strip scheme's strips), one object per
 /// panel holding the patches it covers there, without its tabs: the surface the build
 /// makes, so its distance to the model can be measured. Corners a panel's patches

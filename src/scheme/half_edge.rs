@@ -7,6 +7,10 @@
 //! meet when unrolled around a corner); where the triangle is lower than the wanted
 //! height the tab is shortened. With a face scale `s < 1` the panels are smaller than
 //! the faces and the tab first spans the gap in its own face's plane (a bridge facet).
+//!
+//! In rigid sheet (`--thickness` above zero) nothing folds: each panel is its face cut
+//! back where a neighbour's material needs the room ([`super::rigid`]), and the panels
+//! meet edge to edge.
 
 use glam::{DVec2, DVec3};
 
@@ -19,6 +23,7 @@ use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 use crate::record::{round4, Params};
+use crate::units::fmt_num;
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
 /// outline, plus the fastener holes through it and the neighbour.
@@ -101,8 +106,8 @@ pub enum Connectors {
 
 /// `--connectors`.
 const CONNECTORS: Connectors = Connectors::Tab;
-/// `--connectors` as written.
-const CONNECTORS_TEXT: &str = "tab";
+/// `--connectors` as `--help` states its default.
+const CONNECTORS_WORDS: &str = "tab, or none in rigid sheet (--thickness above zero)";
 /// `--tab-height`.
 const TAB_HEIGHT: &str = "8mm";
 
@@ -120,6 +125,11 @@ struct HalfEdgeArgs {
 
     #[command(flatten)]
     tab: TabArgs,
+
+    /// Material thickness, with a unit: above zero the panels are rigid sheet, each
+    /// cut back from its edges and corners so that no two pass through each other.
+    #[arg(long, value_name = "LENGTH")]
+    thickness: Option<String>,
 }
 
 /// The tab option of the schemes that glue tabs (half-edge, net), as given.
@@ -155,6 +165,8 @@ pub struct HalfEdgeOptions {
     pub tabs: bool,
     /// Wanted height of a tab's overlap with its neighbour (mm).
     pub tab_height: f64,
+    /// Material thickness (mm); above zero the panels are rigid.
+    pub thickness: f64,
 }
 
 impl Scheme for HalfEdge {
@@ -170,8 +182,9 @@ impl Scheme for HalfEdge {
         state_defaults(
             args_of::<HalfEdgeArgs>(),
             &[
-                OptionDefault::value("connectors", CONNECTORS_TEXT),
+                OptionDefault::words("connectors", CONNECTORS_WORDS),
                 tab_defaults(),
+                super::thickness_default(),
             ],
         )
     }
@@ -195,10 +208,23 @@ impl Scheme for HalfEdge {
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
         let args: HalfEdgeArgs = values.parse()?;
+        let thickness = super::thickness("thickness", args.thickness.as_deref(), "0mm", &panel)?;
+        let connectors = match (args.connectors, thickness > 0.0) {
+            (Some(Connectors::Tab), true) => {
+                return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); leave --connectors out or give --connectors none".to_string())
+            }
+            (Some(kind), _) => kind,
+            (None, true) => Connectors::None,
+            (None, false) => CONNECTORS,
+        };
+        if thickness > 0.0 && panel.face_scale != 1.0 {
+            return Err("--face-scale: rigid panels (--thickness above zero) meet at the faces' edges; leave --face-scale at 1".to_string());
+        }
         Ok(Box::new(HalfEdgeOptions {
             panel,
-            tabs: args.connectors.unwrap_or(CONNECTORS) == Connectors::Tab,
+            tabs: connectors == Connectors::Tab,
             tab_height: args.tab.height()?,
+            thickness,
         }))
     }
 }
@@ -209,13 +235,18 @@ impl Configured for HalfEdgeOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        Ok(panels(mesh, self))
+        if self.thickness > 0.0 {
+            rigid_face_panels(mesh, self)
+        } else {
+            Ok(panels(mesh, self))
+        }
     }
 
     fn params(&self) -> Params {
         let mut params = Params::default();
         params.push("connectors", if self.tabs { "tab" } else { "none" });
         params.push("tab_height", round4(self.tab_height));
+        params.push("thickness", round4(self.thickness));
         params
     }
 }
@@ -407,41 +438,49 @@ fn face_labels(
     tabs: &Tabs,
     options: &HalfEdgeOptions,
 ) -> Vec<Label> {
-    let half_edges: Vec<HalfedgeId> = mesh.face_half_edges(f).collect();
-    let n = half_edges.len();
     let tab_of = |h: HalfedgeId| tabs.of_edge(h.edge());
-    let mut labels = Vec::with_capacity(n + 1);
+    let partners = mesh
+        .face_half_edges(f)
+        .enumerate()
+        .filter(|&(_, h)| !options.tabs || tab_of(h).is_some())
+        .filter_map(|(k, h)| Some((k, mesh.face(h.twin())?)));
+    outline_labels(f, band, partners, options.panel.label_height)
+}
+
+/// The labels of face `f`'s panel of outline `points`: its id at the centre, along the
+/// longest side; each partner's id inside the side `(k, partner)` it joins at.
+fn outline_labels(
+    f: FaceId,
+    points: &[DVec3],
+    partners: impl Iterator<Item = (usize, FaceId)>,
+    height: f64,
+) -> Vec<Label> {
+    let n = points.len();
     let longest = (0..n)
         .max_by(|&i, &j| {
-            let li = band[i].distance(band[(i + 1) % n]);
-            let lj = band[j].distance(band[(j + 1) % n]);
+            let li = points[i].distance(points[(i + 1) % n]);
+            let lj = points[j].distance(points[(j + 1) % n]);
             li.total_cmp(&lj).then(j.cmp(&i))
         })
         .unwrap_or(0);
-    let centre = band.iter().copied().sum::<DVec3>() / n as f64;
-    labels.push(Label {
+    let centre = points.iter().copied().sum::<DVec3>() / n as f64;
+    let mut labels = vec![Label {
         text: panel_id(f),
         anchor: centre,
-        direction: (band[(longest + 1) % n] - band[longest]).normalize(),
-        height: options.panel.label_height,
+        direction: (points[(longest + 1) % n] - points[longest]).normalize(),
+        height,
         facet: 0,
         kind: LabelKind::Panel,
         on_edge: false,
         slide: 0.0,
-    });
-    for (k, &h) in half_edges.iter().enumerate() {
-        let Some(g) = mesh.face(h.twin()) else {
-            continue;
-        };
-        if options.tabs && tab_of(h).is_none() {
-            continue;
-        }
-        let (a, b) = (band[k], band[(k + 1) % n]);
+    }];
+    for (k, g) in partners {
+        let (a, b) = (points[k], points[(k + 1) % n]);
         labels.push(Label {
             text: panel_id(g),
             anchor: 0.5 * (a + b),
             direction: (b - a).normalize(),
-            height: options.panel.label_height,
+            height,
             facet: 0,
             kind: LabelKind::Partner,
             on_edge: true,
@@ -450,6 +489,98 @@ fn face_labels(
         });
     }
     labels
+}
+
+/// The face panels in rigid sheet: each face's outline cut back so that no two panels
+/// pass through each other, meeting edge to edge.
+fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOutput, SchemeError> {
+    let t = options.thickness;
+    let rigid = super::rigid::rigid_panels(mesh, t).map_err(|e| too_thick(mesh, t, &e))?;
+    let panels = Panels::build(mesh.face_count(), |f| {
+        let outline = &rigid.outlines[f];
+        let partners = outline
+            .along
+            .iter()
+            .enumerate()
+            .filter_map(|(k, h)| Some((k, mesh.face((*h)?.twin())?)));
+        let f = FaceId(f as u32);
+        let labels = outline_labels(f, &outline.points, partners, options.panel.label_height);
+        let facet: Loops = std::iter::once(0..outline.points.len() as u32).collect();
+        Panel::new(
+            Source::face(f.0),
+            outline.points.clone(),
+            facet,
+            Vec::new(),
+            labels,
+        )
+    });
+    let widest_corner = rigid.vertices_cut.iter().map(|c| c.1).fold(0.0, f64::max);
+    let report = vec![format!(
+        "rigid panels {} mm thick: {} edges cut back (up to {} mm), corners cut back at {} vertices (up to {} mm from the vertex)",
+        fmt_num(t),
+        rigid.edges_cut,
+        fmt_num(rigid.widest_edge_cut),
+        rigid.vertices_cut.len(),
+        fmt_num(widest_corner)
+    )];
+    let mut section = serde_json::Map::new();
+    section.insert("thickness".into(), round4(t).into());
+    section.insert("edges_cut".into(), rigid.edges_cut.into());
+    section.insert(
+        "widest_edge_cut".into(),
+        round4(rigid.widest_edge_cut).into(),
+    );
+    section.insert("vertices_cut".into(), rigid.vertices_cut.len().into());
+    section.insert("widest_vertex_cut".into(), round4(widest_corner).into());
+    let mut manifest = Params::default();
+    manifest.push("rigid", serde_json::Value::Object(section));
+    Ok(SchemeOutput {
+        panels,
+        report,
+        manifest,
+        thickness: t,
+        ..SchemeOutput::default()
+    })
+}
+
+/// The refusal of a thickness the model cannot take at its size, naming the thickness
+/// that fits and the size that takes this one.
+fn too_thick(mesh: &Mesh, thickness: f64, error: &super::rigid::RigidError) -> SchemeError {
+    use super::rigid::RigidError;
+    let what = match error {
+        RigidError::NoRoom { face } => format!(
+            "face {} has no panel left once cut back from its edges and corners",
+            panel_id(*face)
+        ),
+        RigidError::SticksOut { face, depth } => format!(
+            "the panel of {} would stick out of the model by {} mm",
+            panel_id(*face),
+            fmt_num(*depth)
+        ),
+        RigidError::Overlap { faces, depth } => format!(
+            "the panels of {} and {} would pass {} mm into each other",
+            panel_id(faces[0]),
+            panel_id(faces[1]),
+            fmt_num(*depth)
+        ),
+    };
+    let fits = super::rigid::thickest(mesh, thickness);
+    if fits < 1e-3 * thickness {
+        // Insets and cuts grow with the thickness: what fails at every thickness is
+        // the shape itself.
+        return SchemeError::Options(format!(
+            "--thickness {}mm: {what}, and would at any thickness (the faces meet too sharply there for square-cut panels); a simpler model (--target-edges) or another scheme may build",
+            fmt_num(thickness)
+        ));
+    }
+    // Scaling the model up by k takes k times the thickness.
+    let size = mesh.longest_side() * thickness / fits;
+    SchemeError::Options(format!(
+        "--thickness {}mm is too thick for this model at this size: {what}; --thickness {}mm fits, or --size {}mm takes it",
+        fmt_num(thickness),
+        fmt_num((fits * 1e3).floor() / 1e3),
+        (size * 1.001).ceil()
+    ))
 }
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
@@ -604,6 +735,7 @@ mod tests {
             },
             tabs: true,
             tab_height,
+            thickness: 0.0,
         }
     }
 

@@ -12,6 +12,7 @@ pub mod ergs;
 pub mod half_edge;
 pub mod net;
 pub mod quad_edge;
+pub mod rigid;
 pub mod strip;
 pub mod winged_edge;
 pub mod woven;
@@ -452,6 +453,10 @@ pub struct SchemeOutput {
     /// scheme's strips): face groups name its faces, and the map shows it instead of
     /// the scheme's mesh.
     pub surface: Option<Mesh>,
+    /// Above zero, the panels are rigid sheet this thick (mm): each lies with its outer
+    /// face on its facet and its material inward, and the assembled model gives them as
+    /// solids.
+    pub thickness: f64,
 }
 
 /// A build where more than this fraction of the connections holds no fastener hole
@@ -491,6 +496,37 @@ impl SchemeError {
     pub fn is_usage(&self) -> bool {
         matches!(self, SchemeError::Options(_))
     }
+}
+
+/// `--thickness` as `--help` states its default (the schemes that take it differ).
+pub(super) fn thickness_default() -> crate::option_default::OptionDefault {
+    crate::option_default::OptionDefault::words("thickness", "0mm for half-edge, 0.1in for woven")
+}
+
+/// A material thickness as given (`text`, else `default`), in mm: zero or more, and
+/// below the usable sheet's shorter side.
+pub(super) fn thickness(
+    long: &str,
+    text: Option<&str>,
+    default: &str,
+    panel: &PanelOptions,
+) -> Result<f64, String> {
+    let text = text.unwrap_or(default);
+    let thickness = crate::units::parse_length(text).map_err(|e| format!("--{long}: {e}"))?;
+    if !(thickness >= 0.0 && thickness.is_finite()) {
+        return Err(format!("--{long}: '{text}' must be zero or positive"));
+    }
+    // Material thicker than the sheet is wide is a typo (1e300mm would also overflow
+    // the geometry).
+    if let Some(limit) = panel.panel_limit {
+        let widest = limit.width.min(limit.height);
+        if thickness >= widest {
+            return Err(format!(
+                "--{long}: '{text}' is not below the usable sheet's shorter side ({widest:.1} mm); it is the material's thickness"
+            ));
+        }
+    }
+    Ok(thickness)
 }
 
 /// The face band of a face: each corner moved toward the face centre,

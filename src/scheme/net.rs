@@ -719,6 +719,7 @@ fn tab_options(options: &NetOptions, height: f64) -> HalfEdgeOptions {
         panel: options.panel.clone(),
         tabs: true,
         tab_height: height,
+        thickness: 0.0,
     }
 }
 

@@ -50,7 +50,7 @@ const BAND_SCALE: f64 = 0.4;
 /// `--curl-limit`.
 const CURL_LIMIT: f64 = 3.0;
 /// `--thickness`.
-const THICKNESS: &str = "0.1in";
+pub(super) const THICKNESS: &str = "0.1in";
 
 /// The woven options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
@@ -101,7 +101,7 @@ impl Scheme for Woven {
             &[
                 OptionDefault::value("band-scale", BAND_SCALE),
                 OptionDefault::value("curl-limit", CURL_LIMIT),
-                OptionDefault::value("thickness", THICKNESS),
+                super::thickness_default(),
             ],
         )
     }
@@ -143,22 +143,8 @@ impl Scheme for Woven {
                 "--curl-limit: {curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"
             ));
         }
-        let text = args.thickness.as_deref().unwrap_or(THICKNESS);
         let thickness =
-            crate::units::parse_length(text).map_err(|e| format!("--thickness: {e}"))?;
-        if !(thickness >= 0.0 && thickness.is_finite()) {
-            return Err(format!("--thickness: '{text}' must be zero or positive"));
-        }
-        // Material thicker than the sheet is wide is a typo (1e300mm would also
-        // overflow the ribbon geometry).
-        if let Some(limit) = panel.panel_limit {
-            let widest = limit.width.min(limit.height);
-            if thickness >= widest {
-                return Err(format!(
-                    "--thickness: '{text}' is not below the usable sheet's shorter side ({widest:.1} mm); it is the material's thickness"
-                ));
-            }
-        }
+            super::thickness("thickness", args.thickness.as_deref(), THICKNESS, &panel)?;
         Ok(Box::new(WovenOptions {
             panel,
             band_scale,
