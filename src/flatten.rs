@@ -168,7 +168,8 @@ fn hinges_and_folds(
                 hinges.push((f, g, a, b));
                 hinges.push((g, f, a, b));
                 let (nf, ng) = (normals[f as usize], normals[g as usize]);
-                if nf.angle_between(ng) > least_fold {
+                // atan2 of sine and cosine: acos of a cosine next to 1 is off by 1e-8.
+                if nf.cross(ng).length().atan2(nf.dot(ng)) > least_fold {
                     // The edge runs from → to in f.
                     let along =
                         panel.vertices[f_use.to as usize] - panel.vertices[f_use.from as usize];

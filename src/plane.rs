@@ -117,6 +117,11 @@ pub fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
 
 /// True when segments ab and cd share a point (touching counts).
 pub fn segments_intersect(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
+    // Segments whose boxes are apart cannot meet; this also keeps two pieces of one
+    // straight line, apart on it, from crossing by the rounding of their orientations.
+    if a.max(b).cmplt(c.min(d)).any() || c.max(d).cmplt(a.min(b)).any() {
+        return false;
+    }
     let o = |p: DVec2, q: DVec2, r: DVec2| (q - p).perp_dot(r - p);
     let (d1, d2) = (o(c, d, a), o(c, d, b));
     let (d3, d4) = (o(a, b, c), o(a, b, d));
