@@ -128,6 +128,9 @@ pub enum Covers {
     /// The panel's own facets, which lie over the surface (a ribbon); the id at the
     /// centre of its middle facet.
     Itself,
+    /// No surface: a part inside the model at an edge (a bracket), which the map leaves
+    /// out; its id names the edge.
+    Inside(u32),
 }
 
 /// The faces a panel covers when it covers a group of them ([`Covers::Faces`]), and

@@ -50,45 +50,91 @@ fn rigid_job(model: &Path, size: &str, out: &Path) -> unfold::config::Job {
     resolve(o, model)
 }
 
+/// A bracket rebuilt in 3D: its outline on its outer face and its thickness behind.
+struct BracketPart {
+    id: String,
+    edge: u32,
+    outer: Vec<DVec3>,
+    normal: DVec3,
+    /// The ids engraved on it.
+    labels: Vec<String>,
+}
+
+impl BracketPart {
+    fn corners(&self) -> Vec<DVec3> {
+        let inner = self.outer.iter().map(|&p| p - T * self.normal);
+        self.outer.iter().copied().chain(inner).collect()
+    }
+}
+
+/// The rebuilt parts of a rigid build: the face panels (slots as their inner loops)
+/// and the brackets.
+struct Rebuilt {
+    mesh: Mesh,
+    parts: Vec<Part>,
+    slots: Vec<Vec<Vec<DVec3>>>,
+    brackets: Vec<BracketPart>,
+}
+
 /// The parts of a rigid build, rebuilt from the flat panels, and the mesh they cover.
-fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> (Mesh, Vec<Part>) {
+fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
     let job = rigid_job(model, size, out);
     let p = pipeline(&job);
     let frames = frames_of(&p.panels);
-    let mut parts = Vec::new();
+    let mut rebuilt_parts = Vec::new();
+    let mut rebuilt_slots = Vec::new();
+    let mut rebuilt_brackets = Vec::new();
     for ((panel, flat), frames) in p.panels.iter().zip(&p.flat).zip(&frames) {
+        // All facets of a rigid part lie in one plane: the first facet's frame maps
+        // every point back.
+        let loops: Vec<Vec<DVec3>> = flat
+            .outline
+            .iter()
+            .map(|lp| {
+                lp.iter()
+                    .map(|&i| frames[0].to_3d(flat.points[i as usize]))
+                    .collect()
+            })
+            .collect();
+        // What is cut is the part: every corner maps back onto the 3D corner.
+        for (lp, points) in flat.outline.iter().zip(&loops) {
+            for (&i, q) in lp.iter().zip(points) {
+                let want = panel.vertices[i as usize];
+                assert!(
+                    q.distance(want) < 1e-6,
+                    "{}: corner {i} maps to {q}, not {want}",
+                    panel.id()
+                );
+            }
+        }
+        let outer = loops[0].clone();
+        if let Covers::Inside(edge) = panel.source.covers {
+            let id = panel.id().to_string();
+            assert!(id.starts_with('B'), "{id}: a part inside is a bracket");
+            assert_eq!(panel.id().number, edge, "{id}: its id names its edge");
+            assert_eq!(loops.len(), 1, "{id}: a bracket has no inner cut");
+            let normal = vector_area(&outer).normalize();
+            rebuilt_brackets.push(BracketPart {
+                edge: panel.id().number,
+                id,
+                outer,
+                normal,
+                labels: panel.labels.iter().map(|l| l.text.to_string()).collect(),
+            });
+            continue;
+        }
         let Covers::Face(face) = panel.source.covers else {
             panic!("{}: a rigid panel covers one face", panel.id());
         };
-        assert_eq!(panel.facets.len(), 1, "{}: one flat facet", panel.id());
-        assert_eq!(
-            flat.outline.len(),
-            1,
-            "{}: one outline, no inner cut",
-            panel.id()
-        );
-        let outer: Vec<DVec3> = flat.outline[0]
-            .iter()
-            .map(|&i| frames[0].to_3d(flat.points[i as usize]))
-            .collect();
-        // What is cut is the panel: every corner maps back onto the 3D corner.
-        for (&i, q) in flat.outline[0].iter().zip(&outer) {
-            let want = panel.vertices[i as usize];
-            assert!(
-                q.distance(want) < 1e-6,
-                "{}: corner {i} maps to {q}, not {want}",
-                panel.id()
-            );
-        }
         let normal = p.mesh.face_normal(FaceId(face));
-        let area = vector_area(&outer);
         assert!(
-            area.dot(normal) > 0.0,
+            vector_area(&outer).dot(normal) > 0.0,
             "{}: its outer face looks inward",
             panel.id()
         );
-        let on_plane = outer
+        let on_plane = loops
             .iter()
+            .flatten()
             .map(|&q| (q - p.mesh.face_centre(FaceId(face))).dot(normal).abs())
             .fold(0.0, f64::max);
         assert!(
@@ -106,10 +152,16 @@ fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> (Mesh, Vec<Part>) {
             "{}: the faces are convex, so is each part",
             panel.id()
         );
-        parts.push(part);
+        rebuilt_parts.push(part);
+        rebuilt_slots.push(loops[1..].to_vec());
     }
-    assert_eq!(parts.len(), p.mesh.face_count());
-    (p.mesh, parts)
+    assert_eq!(rebuilt_parts.len(), p.mesh.face_count());
+    Rebuilt {
+        mesh: p.mesh,
+        parts: rebuilt_parts,
+        slots: rebuilt_slots,
+        brackets: rebuilt_brackets,
+    }
 }
 
 fn vector_area(points: &[DVec3]) -> DVec3 {
@@ -195,13 +247,19 @@ fn outside_by(poly: &[DVec2], p: DVec2) -> f64 {
 /// Checks the parts of a rigid build of `model` at `size`; returns how many edges have
 /// a groove (obtuse), are acute, and are concave.
 fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
-    let (mesh, parts) = rebuilt_parts(model, size, &tmp.join("job"));
+    let rebuilt = rebuilt_parts(model, size, &tmp.join("job"));
+    let (mesh, parts) = (&rebuilt.mesh, &rebuilt.parts);
     let name = model.file_stem().unwrap().to_string_lossy().into_owned();
+    check_brackets(&name, &rebuilt);
 
     // No two parts pass into each other, near or far in the mesh.
     let mut deepest = (0.0, 0, 0);
+    let boxes: Vec<(DVec3, DVec3)> = parts.iter().map(|p| corners_box(&p.corners())).collect();
     for i in 0..parts.len() {
         for j in i + 1..parts.len() {
+            if !boxes_meet(&boxes[i], &boxes[j]) {
+                continue;
+            }
             let d = penetration(&parts[i], &parts[j]);
             if d > deepest.0 {
                 deepest = (d, parts[i].face, parts[j].face);
@@ -216,21 +274,26 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
         deepest.0
     );
 
-    // No inner corner lies outside the model (or it lies within 0.01 mm of it).
-    let triangles = triangles(&mesh);
-    for part in &parts {
-        for q in part.outer.iter().map(|&p| p - T * part.normal) {
-            if winding(&triangles, q) < 0.5 {
-                let gap = triangles
-                    .iter()
-                    .map(|&t| q.distance(closest_on_triangle(q, t)))
-                    .fold(f64::MAX, f64::min);
-                assert!(
-                    gap <= OVERLAP,
-                    "{name}: F{} sticks out {gap} mm at {q}",
-                    part.face
-                );
-            }
+    // No corner of a part lies outside the model (or it lies within 0.01 mm of it):
+    // the panels' inner corners, and every corner of every bracket.
+    let triangles = triangles(mesh);
+    let panel_corners = parts.iter().flat_map(|part| {
+        let face = format!("F{}", part.face);
+        part.outer
+            .iter()
+            .map(move |&p| (face.clone(), p - T * part.normal))
+    });
+    let bracket_corners = rebuilt
+        .brackets
+        .iter()
+        .flat_map(|b| b.corners().into_iter().map(|p| (b.id.clone(), p)));
+    for (id, q) in panel_corners.chain(bracket_corners) {
+        if winding(&triangles, q) < 0.5 {
+            let gap = triangles
+                .iter()
+                .map(|&t| q.distance(closest_on_triangle(q, t)))
+                .fold(f64::MAX, f64::min);
+            assert!(gap <= OVERLAP, "{name}: {id} sticks out {gap} mm at {q}");
         }
     }
 
@@ -289,9 +352,11 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
     check_output(model, &out, &m, &name, DxfCheck::FirstAndLast, |e| {
         e["id"].as_str().unwrap().to_string()
     });
-    assert_eq!(count(&m, "counts.panels"), mesh.face_count());
+    let all = parts.len() + rebuilt.brackets.len();
+    assert_eq!(count(&m, "counts.panels"), all);
     assert_eq!(m["rigid"]["thickness"].as_f64(), Some(T));
-    assert_closed_solids(&out.join(format!("{name}-assembled.obj")), parts.len());
+    assert_eq!(count(&m, "rigid.brackets"), rebuilt.brackets.len());
+    assert_closed_solids(&out.join(format!("{name}-assembled.obj")), all);
     kinds
 }
 
@@ -423,7 +488,7 @@ fn too_thick_is_refused_with_the_thickness_and_size_that_work() {
 }
 
 #[test]
-fn tabs_and_shrunk_faces_are_refused_in_rigid_sheet() {
+fn tabs_and_shrunk_faces_are_refused_in_rigid_sheet_and_brackets_in_card() {
     let tmp = TempDir::new().unwrap();
     let cube = model("hexahedron");
     for (extra, says) in [
@@ -443,5 +508,259 @@ fn tabs_and_shrunk_faces_are_refused_in_rigid_sheet() {
         let run = unfold(args);
         assert_refusal(says, &run, 2, &[says]);
         assert!(!out.exists());
+    }
+    // Brackets hold rigid panels only: in card, the fix is the thickness.
+    let out = tmp.path().join("card");
+    let run = unfold([
+        cube.to_str().unwrap(),
+        "--size",
+        "200mm",
+        "--connectors",
+        "bracket",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_refusal(
+        "bracket in card",
+        &run,
+        2,
+        &["--connectors bracket", "--thickness"],
+    );
+    assert!(!out.exists());
+}
+
+/// The bounding box of some points.
+fn corners_box(points: &[DVec3]) -> (DVec3, DVec3) {
+    points
+        .iter()
+        .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        })
+}
+
+/// Two boxes overlap (touching counts).
+fn boxes_meet(a: &(DVec3, DVec3), b: &(DVec3, DVec3)) -> bool {
+    a.0.cmple(b.1).all() && b.0.cmple(a.1).all()
+}
+
+/// A polygon's part on the inner side of a plane (`(p - at)·normal <= 0`).
+fn clip_below(poly: &[DVec3], at: DVec3, normal: DVec3) -> Vec<DVec3> {
+    let mut out = Vec::new();
+    for k in 0..poly.len() {
+        let (p, q) = (poly[k], poly[(k + 1) % poly.len()]);
+        let (sp, sq) = ((p - at).dot(normal), (q - at).dot(normal));
+        if sp <= 0.0 {
+            out.push(p);
+        }
+        if (sp <= 0.0) != (sq <= 0.0) {
+            out.push(p + (q - p) * (sp / (sp - sq)));
+        }
+    }
+    out
+}
+
+/// A simple polygon (in a plane of `normal`, counter-clockwise about it) as triangles,
+/// by clipping ears.
+fn ears(poly: &[DVec3], normal: DVec3) -> Vec<Vec<DVec3>> {
+    let turn = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - b).dot(normal);
+    // Corners where the outline runs straight on (a tab's foot on its arm) are no ears.
+    let n = poly.len();
+    let mut left: Vec<DVec3> = (0..n)
+        .filter(|&k| turn(poly[(k + n - 1) % n], poly[k], poly[(k + 1) % n]).abs() > 1e-9)
+        .map(|k| poly[k])
+        .collect();
+    let mut out = Vec::new();
+    while left.len() > 3 {
+        let n = left.len();
+        let ear = (0..n).find(|&k| {
+            let (a, b, c) = (left[(k + n - 1) % n], left[k], left[(k + 1) % n]);
+            turn(a, b, c) > 1e-12
+                && left.iter().all(|&p| {
+                    p == a
+                        || p == b
+                        || p == c
+                        || !(turn(a, b, p) > 1e-12
+                            && turn(b, c, p) > 1e-12
+                            && turn(c, a, p) > 1e-12)
+                })
+        });
+        let Some(k) = ear else {
+            // Clipping can leave a corner running straight on: drop it.
+            let straight = (0..n)
+                .find(|&k| turn(left[(k + n - 1) % n], left[k], left[(k + 1) % n]).abs() <= 1e-9)
+                .expect("a simple polygon has an ear");
+            left.remove(straight);
+            continue;
+        };
+        out.push(vec![left[(k + n - 1) % n], left[k], left[(k + 1) % n]]);
+        left.remove(k);
+    }
+    out.push(left);
+    out
+}
+
+/// The brackets of a rigid build: each names its edge and both panels, its arms meet at
+/// the edge's angle within 0.1°, what of it lies in the material of its two panels lies
+/// in their slots, it passes into no other part, and every slot is T plus the
+/// clearance wide.
+fn check_brackets(name: &str, r: &Rebuilt) {
+    let mesh = &r.mesh;
+    for (part, slots) in r.parts.iter().zip(&r.slots) {
+        for slot in slots {
+            assert_eq!(
+                slot.len(),
+                4,
+                "{name}: F{}: a slot has four corners",
+                part.face
+            );
+            let sides: Vec<f64> = (0..4)
+                .map(|k| slot[k].distance(slot[(k + 1) % 4]))
+                .collect();
+            let narrow = sides.iter().copied().fold(f64::MAX, f64::min);
+            assert!(
+                (narrow - (T + 0.1)).abs() < 1e-6,
+                "{name}: F{}: a slot {narrow} mm wide",
+                part.face
+            );
+            let diagonals = (slot[0].distance(slot[2]), slot[1].distance(slot[3]));
+            assert!(
+                (diagonals.0 - diagonals.1).abs() < 1e-6,
+                "{name}: a slot is not a rectangle"
+            );
+        }
+    }
+    let pieces: Vec<Vec<Part>> = r
+        .brackets
+        .iter()
+        .map(|b| {
+            ears(&b.outer, b.normal)
+                .into_iter()
+                .map(|outer| Part {
+                    face: u32::MAX,
+                    outer,
+                    normal: b.normal,
+                })
+                .collect()
+        })
+        .collect();
+    for (k, b) in r.brackets.iter().enumerate() {
+        let h = unfold::mesh::EdgeId(b.edge).half_edge();
+        let (fa, fb) = (mesh.face(h).unwrap(), mesh.face(h.twin()).unwrap());
+        assert!(
+            b.id.starts_with(&format!("B{}.", b.edge)),
+            "{name}: {}",
+            b.id
+        );
+        for f in [fa, fb] {
+            assert!(
+                b.labels.contains(&format!("F{}", f.0)),
+                "{name}: {} names F{}: {:?}",
+                b.id,
+                f.0,
+                b.labels
+            );
+        }
+        // The arms lie on the two panels' inner faces and meet at the edge's angle.
+        let (na, nb) = (mesh.face_normal(fa), mesh.face_normal(fb));
+        let inner_a = |p: DVec3| (p - mesh.face_centre(fa)).dot(na) + T;
+        let inner_b = |p: DVec3| (p - mesh.face_centre(fb)).dot(nb) + T;
+        let (a, bb) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
+        let along = (bb - a).normalize();
+        let (into_a, into_b) = (na.cross(along), along.cross(nb));
+        // The elbow: on both inner faces, nearest the edge's line.
+        let off_line = |p: DVec3| (p - a).reject_from_normalized(along).length();
+        let elbow = b
+            .outer
+            .iter()
+            .copied()
+            .filter(|&p| inner_a(p).abs() < 1e-6 && inner_b(p).abs() < 1e-6)
+            .min_by(|p, q| off_line(*p).total_cmp(&off_line(*q)))
+            .unwrap_or_else(|| panic!("{name}: {} has no corner on both inner faces", b.id));
+        // Each arm's far end: the corner on its panel's inner face farthest from the
+        // elbow on that panel's side.
+        let far_end = |on: &dyn Fn(DVec3) -> f64, into: DVec3| {
+            b.outer
+                .iter()
+                .copied()
+                .filter(|&p| on(p).abs() < 1e-6 && (p - elbow).dot(into) > 0.0)
+                .max_by(|p, q| p.distance(elbow).total_cmp(&q.distance(elbow)))
+                .unwrap_or_else(|| panic!("{name}: {} has an arm off its panel", b.id))
+        };
+        let ua = (far_end(&inner_a, into_a) - elbow).normalize();
+        let ub = (far_end(&inner_b, into_b) - elbow).normalize();
+        let arms = ua.dot(ub).clamp(-1.0, 1.0).acos();
+        let delta = PI - na.cross(nb).dot(along).atan2(na.dot(nb));
+        // Two directions meet at most at 180°: at a concave edge the bracket wraps the
+        // other way round, through 360° less that.
+        let expected = if delta > PI { 2.0 * PI - delta } else { delta };
+        assert!(
+            (arms - expected).abs().to_degrees() < 0.1,
+            "{name}: {}: arms at {:.3}°, edge at {:.3}°",
+            b.id,
+            arms.to_degrees(),
+            delta.to_degrees()
+        );
+        // In each of its panels' material (less a hundredth either side), only its
+        // tabs, and those in slots.
+        for (f, part) in [fa, fb].map(|f| (f, &r.parts[f.0 as usize])) {
+            let o = part.outer[0];
+            let x = (part.outer[1] - o).normalize();
+            let y = part.normal.cross(x);
+            let flat = |p: DVec3| DVec2::new((p - o).dot(x), (p - o).dot(y));
+            let outline: Vec<DVec2> = part.outer.iter().map(|&p| flat(p)).collect();
+            let slots: Vec<Vec<DVec2>> = r.slots[f.0 as usize]
+                .iter()
+                .map(|s| s.iter().map(|&p| flat(p)).collect())
+                .collect();
+            let inner: Vec<DVec3> = b.outer.iter().map(|&p| p - T * b.normal).collect();
+            for face in [&b.outer, &inner] {
+                let below_outer = clip_below(face, o - OVERLAP * part.normal, part.normal);
+                let in_slab =
+                    clip_below(&below_outer, o - (T - OVERLAP) * part.normal, -part.normal);
+                for p in in_slab {
+                    let q = flat(p);
+                    let in_slot = slots.iter().any(|s| outside_by(s, q) < 1e-6);
+                    assert!(
+                        outside_by(&outline, q) > -1e-9 && (!inside(&outline, q) || in_slot),
+                        "{name}: {} passes into F{} at {p} outside its slots",
+                        b.id,
+                        f.0
+                    );
+                }
+            }
+        }
+        // Clear of every other panel and every other bracket (where their boxes meet).
+        let near = |c: &[DVec3]| boxes_meet(&corners_box(&b.corners()), &corners_box(c));
+        for part in r.parts.iter().filter(|p| p.face != fa.0 && p.face != fb.0) {
+            if !near(&part.corners()) {
+                continue;
+            }
+            for piece in &pieces[k] {
+                let d = penetration(part, piece);
+                assert!(
+                    d <= OVERLAP,
+                    "{name}: {} passes {d} mm into F{}",
+                    b.id,
+                    part.face
+                );
+            }
+        }
+        for (j, other) in r.brackets.iter().enumerate().skip(k + 1) {
+            if !near(&other.corners()) {
+                continue;
+            }
+            for (p, q) in pieces[k]
+                .iter()
+                .flat_map(|p| pieces[j].iter().map(move |q| (p, q)))
+            {
+                let d = penetration(p, q);
+                assert!(
+                    d <= OVERLAP,
+                    "{name}: {} passes {d} mm into {}",
+                    b.id,
+                    other.id
+                );
+            }
+        }
     }
 }

@@ -328,7 +328,7 @@ pub fn panel_source(
             push("face", f.into());
             push("input_face", input_face(f).into());
         }
-        Covers::Edge(e) => push("edge", e.into()),
+        Covers::Edge(e) | Covers::Inside(e) => push("edge", e.into()),
         Covers::Faces(k) => {
             let faces = face_groups
                 .get(k as usize)

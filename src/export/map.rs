@@ -18,7 +18,7 @@ use super::map_page::{fit, text_width, wrap, Lines, Palette, LINE};
 use super::{escape, fmt_mm};
 use crate::nest::Layout;
 use crate::panel::surface::{PanelSurface, Patch};
-use crate::panel::{IdKind, Panels};
+use crate::panel::{Covers, IdKind, Panels};
 
 /// A direction the model is seen from.
 pub(super) struct View {
@@ -144,10 +144,17 @@ pub fn assembly_map(input: &MapInput) -> Vec<String> {
         .map(|v| bounds(patches.iter().flat_map(|p| &p.points), v))
         .collect();
     let all = input.panels.len();
+    // Parts inside the model (brackets) are not drawn: their ids name their edge.
+    let is_inside: Vec<bool> = input
+        .panels
+        .iter()
+        .map(|p| matches!(p.source.covers, Covers::Inside(_)))
+        .collect();
+    let inside = is_inside.iter().filter(|&&n| n).count();
     let page = Page::new(
         input,
         &title_text(input),
-        &key_text(input.panels, [all, all, all], all + 1),
+        &key_text(input.panels, [all, all, all, inside], all + 1),
         true,
     );
     let grid = Grid::largest(&page, &views, &extents);
@@ -162,18 +169,18 @@ pub fn assembly_map(input: &MapInput) -> Vec<String> {
 
     let mut out = String::new();
     page_head(&mut out, &page);
-    let mut named = vec![false; input.panels.len()];
+    let mut named = is_inside;
     for (k, view) in views.iter().enumerate() {
         draw_view(&mut out, &map, k, view, extents[k], &mut named);
     }
     let count = |named: &[bool]| named.iter().filter(|&&n| n).count();
-    let on_overview = count(&named);
+    let on_overview = count(&named) - inside;
     let close_ups = close_up_pages(&map, &mut named);
     let closer = count(&named) - on_overview;
     let unnamed = input.panels.len() - count(&named);
     let key = key_text(
         input.panels,
-        [on_overview, closer, unnamed],
+        [on_overview, closer, unnamed, inside],
         close_ups.len() + 1,
     );
     legend(&mut out, &map, &page, &key);
@@ -848,15 +855,21 @@ fn legend(out: &mut String, map: &MapContext, page: &Page, key: &str) {
 
 /// The overview's key: what the ids mean and how many panels are named here, in the
 /// close-ups on the map's later pages (`pages` in all), and not at all.
-fn key_text(panels: &Panels, [named, closer, unnamed]: [usize; 3], pages: usize) -> String {
+fn key_text(panels: &Panels, [named, closer, unnamed, inside]: [usize; 4], pages: usize) -> String {
     let ids = id_legend(panels);
-    let total = panels.len();
+    let total = panels.len() - inside.min(panels.len());
     let later = match pages {
         0 | 1 => String::new(),
         2 => format!(", {closer} more in the close-ups on page 2"),
         _ => format!(", {closer} more in the close-ups on pages 2 to {pages}"),
     };
-    match unnamed {
+    let within = match inside {
+        0 => String::new(),
+        n => format!(
+            " {n} parts inside the model are not drawn: each stands at the edge its id names."
+        ),
+    };
+    let named = match unnamed {
         0 if pages <= 1 => format!(
             "Ids: {ids}. {named} of {total} panels named; one crowded out of a view is named in another."
         ),
@@ -864,7 +877,8 @@ fn key_text(panels: &Panels, [named, closer, unnamed]: [usize; 3], pages: usize)
         _ => format!(
             "Ids: {ids}. {named} of {total} panels named here{later}; {unnamed} not named: this paper has no room for their close-ups (a larger --sheet has)."
         ),
-    }
+    };
+    named + &within
 }
 
 /// The key of a page of close-ups.

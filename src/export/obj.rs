@@ -30,39 +30,47 @@ pub fn assembled_obj(panels: &Panels) -> String {
 }
 
 /// The OBJ text of rigid panels `thickness` mm thick as they sit in the model: each a
-/// closed solid (its outer facet, the same moved inward, and the square-cut sides
-/// between), one object per panel.
+/// closed solid (its facets, the same moved inward and turned over, and a square-cut
+/// side along every cut edge, slots included), one object per panel.
 pub fn solid_obj(panels: &Panels, thickness: f64) -> String {
     let mut out = format!("{} (mm)\n", super::folder::ASSEMBLED_HEADER);
     let mut base = 1usize;
     for panel in panels {
         let _ = writeln!(out, "o {}", panel.id());
-        for facet in panel.facets {
-            let corners: Vec<glam::DVec3> =
-                facet.iter().map(|&i| panel.vertices[i as usize]).collect();
-            let normal = vector_area(&corners).normalize_or_zero();
-            let inner = corners.iter().map(|&p| p - thickness * normal);
-            for v in corners.iter().copied().chain(inner) {
-                let _ = writeln!(out, "v {} {} {}", fmt_mm(v.x), fmt_mm(v.y), fmt_mm(v.z));
-            }
-            let n = corners.len();
-            let outer: Vec<String> = (0..n).map(|k| (base + k).to_string()).collect();
-            let _ = writeln!(out, "f {}", outer.join(" "));
-            let inner: Vec<String> = (0..n).rev().map(|k| (base + n + k).to_string()).collect();
-            let _ = writeln!(out, "f {}", inner.join(" "));
-            for k in 0..n {
-                let j = (k + 1) % n;
-                let _ = writeln!(
-                    out,
-                    "f {} {} {} {}",
-                    base + j,
-                    base + k,
-                    base + n + k,
-                    base + n + j
-                );
-            }
-            base += 2 * n;
+        let Some(first) = panel.facets.first() else {
+            continue;
+        };
+        // Every facet of a rigid panel lies in one plane.
+        let corners: Vec<glam::DVec3> = first.iter().map(|&i| panel.vertices[i as usize]).collect();
+        let normal = vector_area(&corners).normalize_or_zero();
+        let n = panel.vertices.len();
+        let inner = panel.vertices.iter().map(|&p| p - thickness * normal);
+        for v in panel.vertices.iter().copied().chain(inner) {
+            let _ = writeln!(out, "v {} {} {}", fmt_mm(v.x), fmt_mm(v.y), fmt_mm(v.z));
         }
+        let mut used = std::collections::BTreeSet::new();
+        for facet in panel.facets {
+            let top: Vec<String> = facet
+                .iter()
+                .map(|&i| (base + i as usize).to_string())
+                .collect();
+            let _ = writeln!(out, "f {}", top.join(" "));
+            let bottom: Vec<String> = facet
+                .iter()
+                .rev()
+                .map(|&i| (base + n + i as usize).to_string())
+                .collect();
+            let _ = writeln!(out, "f {}", bottom.join(" "));
+            for k in 0..facet.len() {
+                used.insert((facet[k], facet[(k + 1) % facet.len()]));
+            }
+        }
+        // A side wall along every edge that only one facet uses: the cut edges.
+        for &(i, j) in used.iter().filter(|&&(i, j)| !used.contains(&(j, i))) {
+            let (i, j) = (base + i as usize, base + j as usize);
+            let _ = writeln!(out, "f {j} {i} {} {}", i + n, j + n);
+        }
+        base += 2 * n;
     }
     out
 }

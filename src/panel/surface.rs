@@ -78,6 +78,8 @@ fn patches<'a>(mesh: &Mesh, panels: &Panels, group: impl Fn(u32) -> &'a [u32]) -
                     }
                 }
             }
+            // Inside the model: nothing of the surface is its.
+            Covers::Inside(_) => {}
             Covers::Itself => {
                 for facet in panel.facets.iter() {
                     let points: Vec<DVec3> =
@@ -106,12 +108,12 @@ pub fn group_anchor(mesh: &Mesh, faces: &[u32]) -> DVec3 {
         .unwrap_or(DVec3::ZERO)
 }
 
-/// Where a panel's id goes: its face's centre, its edge's midpoint, the centre of its
-/// own middle facet.
+/// Where a panel's id goes: its face's centre, its edge's midpoint (also for a part
+/// inside at an edge), the centre of its own middle facet.
 fn anchor(mesh: &Mesh, covers: Covers, vertices: &[DVec3], facets: Vec<&[u32]>) -> DVec3 {
     match covers {
         Covers::Face(f) => mesh.face_centre(FaceId(f)),
-        Covers::Edge(e) => {
+        Covers::Edge(e) | Covers::Inside(e) => {
             let (a, b) = mesh.edge_vertices(EdgeId(e));
             0.5 * (mesh.position(a) + mesh.position(b))
         }

@@ -100,6 +100,9 @@ pub struct HalfEdge;
 pub enum Connectors {
     /// A glue or pin tab on one of the two panels.
     Tab,
+    /// Rigid sheet only: a flat bracket inside the model square to each edge, held in
+    /// slots through both panels.
+    Bracket,
     /// Nothing: panels meet edge to edge.
     None,
 }
@@ -107,7 +110,9 @@ pub enum Connectors {
 /// `--connectors`.
 const CONNECTORS: Connectors = Connectors::Tab;
 /// `--connectors` as `--help` states its default.
-const CONNECTORS_WORDS: &str = "tab, or none in rigid sheet (--thickness above zero)";
+const CONNECTORS_WORDS: &str = "tab, or bracket in rigid sheet (--thickness above zero)";
+/// `--slot-clearance`.
+const SLOT_CLEARANCE: &str = "0.1mm";
 /// `--tab-height`.
 const TAB_HEIGHT: &str = "8mm";
 
@@ -130,6 +135,11 @@ struct HalfEdgeArgs {
     /// cut back from its edges and corners so that no two pass through each other.
     #[arg(long, value_name = "LENGTH")]
     thickness: Option<String>,
+
+    /// Play of a bracket's tab in its slot, with a unit: the slot is the thickness plus
+    /// this wide (and the tab's length plus this long).
+    #[arg(long, value_name = "LENGTH")]
+    slot_clearance: Option<String>,
 }
 
 /// The tab option of the schemes that glue tabs (half-edge, net), as given.
@@ -167,6 +177,8 @@ pub struct HalfEdgeOptions {
     pub tab_height: f64,
     /// Material thickness (mm); above zero the panels are rigid.
     pub thickness: f64,
+    /// Brackets between rigid panels, if wanted.
+    pub brackets: Option<super::bracket::BracketSizes>,
 }
 
 impl Scheme for HalfEdge {
@@ -185,6 +197,7 @@ impl Scheme for HalfEdge {
                 OptionDefault::words("connectors", CONNECTORS_WORDS),
                 tab_defaults(),
                 super::thickness_default(),
+                OptionDefault::value("slot-clearance", SLOT_CLEARANCE),
             ],
         )
     }
@@ -211,12 +224,21 @@ impl Scheme for HalfEdge {
         let thickness = super::thickness("thickness", args.thickness.as_deref(), "0mm", &panel)?;
         let connectors = match (args.connectors, thickness > 0.0) {
             (Some(Connectors::Tab), true) => {
-                return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); leave --connectors out or give --connectors none".to_string())
+                return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); give --connectors bracket or none".to_string())
+            }
+            (Some(Connectors::Bracket), false) => {
+                return Err("--connectors bracket: brackets hold rigid panels; give the material's --thickness (3mm plywood: --thickness 3mm), or --connectors tab".to_string())
             }
             (Some(kind), _) => kind,
-            (None, true) => Connectors::None,
+            (None, true) => Connectors::Bracket,
             (None, false) => CONNECTORS,
         };
+        let clearance =
+            crate::units::parse_length(args.slot_clearance.as_deref().unwrap_or(SLOT_CLEARANCE))
+                .map_err(|e| format!("--slot-clearance: {e}"))?;
+        if !(0.0..10.0).contains(&clearance) {
+            return Err(format!("--slot-clearance: {clearance} mm must be at least 0 and below 10 mm (a tab's play in its slot)"));
+        }
         if thickness > 0.0 && panel.face_scale != 1.0 {
             return Err("--face-scale: rigid panels (--thickness above zero) meet at the faces' edges; leave --face-scale at 1".to_string());
         }
@@ -225,6 +247,10 @@ impl Scheme for HalfEdge {
             tabs: connectors == Connectors::Tab,
             tab_height: args.tab.height()?,
             thickness,
+            brackets: (connectors == Connectors::Bracket).then_some(super::bracket::BracketSizes {
+                thickness,
+                clearance,
+            }),
         }))
     }
 }
@@ -244,9 +270,17 @@ impl Configured for HalfEdgeOptions {
 
     fn params(&self) -> Params {
         let mut params = Params::default();
-        params.push("connectors", if self.tabs { "tab" } else { "none" });
+        let connectors = match (self.tabs, self.brackets.is_some()) {
+            (true, _) => "tab",
+            (false, true) => "bracket",
+            (false, false) => "none",
+        };
+        params.push("connectors", connectors);
         params.push("tab_height", round4(self.tab_height));
         params.push("thickness", round4(self.thickness));
+        if let Some(sizes) = self.brackets {
+            params.push("slot_clearance", round4(sizes.clearance));
+        }
         params
     }
 }
@@ -496,26 +530,34 @@ fn outline_labels(
 fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOutput, SchemeError> {
     let t = options.thickness;
     let rigid = super::rigid::rigid_panels(mesh, t).map_err(|e| too_thick(mesh, t, &e))?;
-    let panels = Panels::build(mesh.face_count(), |f| {
+    let (brackets, bare) = match options.brackets {
+        Some(sizes) => super::bracket::clear_brackets(mesh, &rigid.outlines, sizes),
+        None => (Vec::new(), Vec::new()),
+    };
+    let mut slots: Vec<Vec<super::bracket::Slot>> = vec![Vec::new(); mesh.face_count()];
+    for slot in brackets.iter().flat_map(|b| b.slots) {
+        if let Some(f) = mesh.face(slot.side) {
+            slots[f.0 as usize].push(slot);
+        }
+    }
+    let mut panels = Panels::build(mesh.face_count(), |f| {
         let outline = &rigid.outlines[f];
         let partners = outline
             .along
             .iter()
             .enumerate()
             .filter_map(|(k, h)| Some((k, mesh.face((*h)?.twin())?)));
-        let f = FaceId(f as u32);
-        let labels = outline_labels(f, &outline.points, partners, options.panel.label_height);
-        let facet: Loops = std::iter::once(0..outline.points.len() as u32).collect();
-        Panel::new(
-            Source::face(f.0),
-            outline.points.clone(),
-            facet,
-            Vec::new(),
-            labels,
-        )
+        let face = FaceId(f as u32);
+        let labels = outline_labels(face, &outline.points, partners, options.panel.label_height);
+        let (vertices, facets) = super::bracket::slotted_facets(mesh, outline, &slots[f]);
+        Panel::new(Source::face(face.0), vertices, facets, Vec::new(), labels)
     });
+    for bracket in &brackets {
+        let panel = super::bracket::bracket_panel(bracket, options.panel.label_height);
+        panels.push(panel.view());
+    }
     let widest_corner = rigid.vertices_cut.iter().map(|c| c.1).fold(0.0, f64::max);
-    let report = vec![format!(
+    let mut report = vec![format!(
         "rigid panels {} mm thick: {} edges cut back (up to {} mm), corners cut back at {} vertices (up to {} mm from the vertex)",
         fmt_num(t),
         rigid.edges_cut,
@@ -523,6 +565,27 @@ fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOut
         rigid.vertices_cut.len(),
         fmt_num(widest_corner)
     )];
+    let mut notes = Vec::new();
+    if options.brackets.is_some() {
+        report.push(format!(
+            "brackets: {} (ids B<edge>.<n>, the angle between the arms engraved), slots {} mm wide",
+            brackets.len(),
+            fmt_num(t + options.brackets.map_or(0.0, |b| b.clearance))
+        ));
+        if !bare.is_empty() {
+            let named: Vec<String> = bare
+                .iter()
+                .take(5)
+                .map(|e| Name::edge(e.0).to_string())
+                .collect();
+            notes.push(format!(
+                "{} interior edges have no bracket ({}{}): their panels have no room for a slot's collar there, or an arm would meet another part; glue them, or build larger",
+                bare.len(),
+                named.join(", "),
+                if bare.len() > 5 { ", …" } else { "" }
+            ));
+        }
+    }
     let mut section = serde_json::Map::new();
     section.insert("thickness".into(), round4(t).into());
     section.insert("edges_cut".into(), rigid.edges_cut.into());
@@ -532,10 +595,16 @@ fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOut
     );
     section.insert("vertices_cut".into(), rigid.vertices_cut.len().into());
     section.insert("widest_vertex_cut".into(), round4(widest_corner).into());
+    if options.brackets.is_some() {
+        section.insert("brackets".into(), brackets.len().into());
+        section.insert("edges_without_bracket".into(), bare.len().into());
+    }
     let mut manifest = Params::default();
     manifest.push("rigid", serde_json::Value::Object(section));
     Ok(SchemeOutput {
         panels,
+        connections: brackets.len(),
+        notes,
         report,
         manifest,
         thickness: t,
@@ -736,6 +805,7 @@ mod tests {
             tabs: true,
             tab_height,
             thickness: 0.0,
+            brackets: None,
         }
     }
 

@@ -7,6 +7,7 @@
 //! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
 //! module reaches the schemes only through a [`Registry`].
 
+pub mod bracket;
 pub mod edge_panel;
 pub mod ergs;
 pub mod half_edge;

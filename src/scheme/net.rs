@@ -720,6 +720,7 @@ fn tab_options(options: &NetOptions, height: f64) -> HalfEdgeOptions {
         tabs: true,
         tab_height: height,
         thickness: 0.0,
+        brackets: None,
     }
 }
 

@@ -16,7 +16,7 @@ use glam::{DVec2, DVec3};
 use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
 
 /// Two parts may overlap by this much (mm): rounding, not material.
-const OVERLAP_TOLERANCE: f64 = 1e-6;
+pub(super) const OVERLAP_TOLERANCE: f64 = 1e-6;
 
 /// Shortest side a cut-back outline may keep along a face edge (mm).
 const SHORTEST_SIDE: f64 = 1e-3;
@@ -589,7 +589,7 @@ fn check_apart(
 /// A convex part of a panel: a convex polygon on the face plane moved inward by the
 /// thickness.
 #[derive(Clone, Debug)]
-struct Prism {
+pub(super) struct Prism {
     /// The outer polygon's corners, then the inner one's.
     corners: Vec<DVec3>,
     /// Directions whose planes bound it (its faces' normals).
@@ -608,24 +608,51 @@ fn prisms_of(frame: &FaceFrame, outline: &FlatOutline, thickness: f64) -> Vec<Pr
     pieces
         .iter()
         .map(|piece| {
-            let outer: Vec<DVec3> = piece.iter().map(|&p| frame.to_3d(p)).collect();
-            let depth = thickness * frame.normal;
-            let mut corners = outer.clone();
-            corners.extend(outer.iter().map(|&p| p - depth));
-            let sides: Vec<DVec3> = (0..outer.len())
-                .map(|k| (outer[(k + 1) % outer.len()] - outer[k]).normalize_or_zero())
-                .collect();
-            let mut normals: Vec<DVec3> = sides.iter().map(|s| s.cross(frame.normal)).collect();
-            normals.push(frame.normal);
-            let mut edges = sides;
-            edges.push(frame.normal);
-            Prism {
-                corners,
-                normals,
-                edges,
-            }
+            let outer = piece.iter().map(|&p| frame.to_3d(p)).collect();
+            Prism::new(outer, frame.normal, thickness)
         })
         .collect()
+}
+
+impl Prism {
+    /// The convex polygon `outer` (counter-clockwise about `normal`) moved
+    /// `thickness` against `normal`.
+    pub(super) fn new(outer: Vec<DVec3>, normal: DVec3, thickness: f64) -> Prism {
+        let mut corners = outer.clone();
+        corners.extend(outer.iter().map(|&p| p - thickness * normal));
+        let sides: Vec<DVec3> = (0..outer.len())
+            .map(|k| (outer[(k + 1) % outer.len()] - outer[k]).normalize_or_zero())
+            .collect();
+        let mut normals: Vec<DVec3> = sides.iter().map(|s| s.cross(normal)).collect();
+        normals.push(normal);
+        let mut edges = sides;
+        edges.push(normal);
+        Prism {
+            corners,
+            normals,
+            edges,
+        }
+    }
+}
+
+/// A panel of `outline` on a plane of `normal`, as convex prisms.
+pub(super) fn outline_prisms(outline: &RigidOutline, normal: DVec3, thickness: f64) -> Vec<Prism> {
+    let origin = outline.points.first().copied().unwrap_or(DVec3::ZERO);
+    let x = outline
+        .points
+        .get(1)
+        .map_or(DVec3::X, |&p| (p - origin).normalize_or_zero());
+    let frame = FaceFrame {
+        origin,
+        x,
+        y: normal.cross(x),
+        normal,
+    };
+    let flat = FlatOutline {
+        points: outline.points.iter().map(|&p| frame.to_2d(p)).collect(),
+        along: outline.along.clone(),
+    };
+    prisms_of(&frame, &flat, thickness)
 }
 
 /// Every turn of a closed polygon is to the left (or straight on).
@@ -669,7 +696,7 @@ fn inside_triangle(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> bool {
 }
 
 /// How deep two sets of convex prisms overlap (mm): the deepest pair.
-fn overlap(a: &[Prism], b: &[Prism]) -> f64 {
+pub(super) fn overlap(a: &[Prism], b: &[Prism]) -> f64 {
     a.iter()
         .flat_map(|p| b.iter().map(move |q| prism_overlap(p, q)))
         .fold(0.0, f64::max)
