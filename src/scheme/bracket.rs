@@ -539,31 +539,10 @@ pub fn clear_brackets(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::build_from_faces;
     use crate::scheme::rigid::rigid_panels;
 
-    /// A cube of side 200 mm.
     fn cube() -> Mesh {
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) * 200.0;
-        let positions = vec![
-            p(0., 0., 0.),
-            p(1., 0., 0.),
-            p(1., 1., 0.),
-            p(0., 1., 0.),
-            p(0., 0., 1.),
-            p(1., 0., 1.),
-            p(1., 1., 1.),
-            p(0., 1., 1.),
-        ];
-        let faces: [[u32; 4]; 6] = [
-            [0, 3, 2, 1],
-            [4, 5, 6, 7],
-            [0, 1, 5, 4],
-            [1, 2, 6, 5],
-            [2, 3, 7, 6],
-            [3, 0, 4, 7],
-        ];
-        build_from_faces(positions, &faces).expect("cube builds")
+        crate::scheme::rigid::cube(200.0)
     }
 
     #[test]
