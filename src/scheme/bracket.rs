@@ -331,6 +331,11 @@ fn collar_fits(mesh: &Mesh, outline: &RigidOutline, k: usize, slot: &Slot) -> bo
     far.iter().all(|&c| over_outline(outline, c))
 }
 
+/// The box around some prisms.
+fn prisms_box(prisms: &[Prism]) -> (DVec3, DVec3) {
+    crate::mesh::geometry::bounding_box(prisms.iter().flat_map(|p| p.corners.iter().copied()))
+}
+
 /// Two brackets' collars on one face would meet.
 fn collars_meet(mesh: &Mesh, a: &Bracket, b: &Bracket) -> bool {
     let footprint = |slot: &Slot| {
@@ -507,27 +512,50 @@ pub fn clear_brackets(
             })
             .collect()
     };
-    let mut kept: Vec<(Bracket, Vec<Prism>)> = Vec::new();
+    let boxes = |prisms: &[Prism]| prisms_box(prisms);
+    let panel_boxes: Vec<(DVec3, DVec3)> = panels.iter().map(|p| boxes(p)).collect();
+    let mut kept: Vec<(Bracket, Vec<Prism>, (DVec3, DVec3))> = Vec::new();
+    // The brackets kept on each face, whose collars a new one there must keep clear of.
+    let mut on_face: Vec<Vec<usize>> = vec![Vec::new(); mesh.face_count()];
+    let faces_of = |b: &Bracket| {
+        b.slots
+            .map(|s| mesh.face(s.side).map_or(0, |f| f.0 as usize))
+    };
     for place in bracket_places(mesh, outlines, sizes) {
         let chosen = place.into_iter().find_map(|bracket| {
             let arms = arm_prisms(&bracket);
-            let clear = !kept
+            let reach = boxes(&arms);
+            let meets = |other: &(DVec3, DVec3)| {
+                reach.0.cmple(other.1).all() && other.0.cmple(reach.1).all()
+            };
+            let collars_clear = faces_of(&bracket)
                 .iter()
-                .any(|(other, _)| collars_meet(mesh, other, &bracket))
+                .flat_map(|&f| &on_face[f])
+                .all(|&k| !collars_meet(mesh, &kept[k].0, &bracket));
+            let clear = collars_clear
                 && panels
                     .iter()
-                    .all(|p| overlap(p, &arms) <= OVERLAP_TOLERANCE)
+                    .zip(&panel_boxes)
+                    .filter(|(_, b)| meets(b))
+                    .all(|(p, _)| overlap(p, &arms) <= OVERLAP_TOLERANCE)
                 && kept
                     .iter()
-                    .all(|(_, other)| overlap(other, &arms) <= OVERLAP_TOLERANCE);
-            clear.then_some((bracket, arms))
+                    .filter(|(_, _, b)| meets(b))
+                    .all(|(_, other, _)| overlap(other, &arms) <= OVERLAP_TOLERANCE);
+            clear.then_some((bracket, arms, reach))
         });
-        if let Some((mut bracket, arms)) = chosen {
-            bracket.part = 1 + kept.iter().filter(|(b, _)| b.edge == bracket.edge).count() as u32;
-            kept.push((bracket, arms));
+        if let Some((mut bracket, arms, reach)) = chosen {
+            bracket.part = 1 + kept
+                .iter()
+                .filter(|(b, _, _)| b.edge == bracket.edge)
+                .count() as u32;
+            for f in faces_of(&bracket) {
+                on_face[f].push(kept.len());
+            }
+            kept.push((bracket, arms, reach));
         }
     }
-    let kept: Vec<Bracket> = kept.into_iter().map(|(b, _)| b).collect();
+    let kept: Vec<Bracket> = kept.into_iter().map(|(b, _, _)| b).collect();
     let bare = mesh
         .edges()
         .filter(|&e| !mesh.is_boundary_edge(e))

@@ -407,10 +407,19 @@ impl Corner<'_> {
     }
 }
 
-/// The model as a solid, where it is closed: which points lie outside it.
+/// The model as a solid, where it is closed: which points lie outside it, by casting
+/// a ray along +z and counting the surface's crossings (odd: inside). The triangles are
+/// binned by their shadow on the xy plane, so a ray meets only those over its cell.
 struct Solid {
     /// Its faces as triangles; empty when the model is open (no inside to keep to).
     triangles: Vec<[DVec3; 3]>,
+    /// The grid's corner, cell side and cells across and down.
+    lo: DVec2,
+    cell: f64,
+    dims: [usize; 2],
+    /// The triangles over each cell (CSR: cell k's are `entries[starts[k]..starts[k + 1]]`).
+    starts: Vec<u32>,
+    entries: Vec<u32>,
 }
 
 impl Solid {
@@ -421,23 +430,112 @@ impl Solid {
             let p: Vec<DVec3> = mesh.face_positions(f).collect();
             triangles.extend((1..p.len() - 1).map(|k| [p[0], p[k], p[k + 1]]));
         }
-        Solid { triangles }
+        let shadow = |t: &[DVec3; 3]| {
+            let xy = t.map(|p| p.truncate());
+            (xy[0].min(xy[1]).min(xy[2]), xy[0].max(xy[1]).max(xy[2]))
+        };
+        let (lo, hi) = triangles.iter().map(shadow).fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), (a, b)| (lo.min(a), hi.max(b)),
+        );
+        let mut extents: Vec<f64> = triangles
+            .iter()
+            .map(|t| {
+                let (a, b) = shadow(t);
+                (b - a).max_element()
+            })
+            .collect();
+        extents.sort_by(f64::total_cmp);
+        let size = (hi - lo).max(DVec2::splat(1e-9));
+        let typical = extents.get(extents.len() / 2).copied().unwrap_or(1.0);
+        let cell = typical.max(size.max_element() / 1024.0).max(1e-9);
+        let dims = [size.x, size.y].map(|s| (s / cell) as usize + 1);
+        let index = |p: DVec2| {
+            let k = ((p - lo) / cell).floor();
+            [
+                (k.x.max(0.0) as usize).min(dims[0] - 1),
+                (k.y.max(0.0) as usize).min(dims[1] - 1),
+            ]
+        };
+        let mut starts = vec![0u32; dims[0] * dims[1] + 1];
+        let ranges: Vec<([usize; 2], [usize; 2])> = triangles
+            .iter()
+            .map(|t| {
+                let (a, b) = shadow(t);
+                (index(a), index(b))
+            })
+            .collect();
+        for &(a, b) in &ranges {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    starts[x + dims[0] * y + 1] += 1;
+                }
+            }
+        }
+        for k in 1..starts.len() {
+            starts[k] += starts[k - 1];
+        }
+        let mut fill = starts.clone();
+        let mut entries = vec![0u32; *starts.last().unwrap_or(&0) as usize];
+        for (t, &(a, b)) in ranges.iter().enumerate() {
+            for y in a[1]..=b[1] {
+                for x in a[0]..=b[0] {
+                    let c = x + dims[0] * y;
+                    entries[fill[c] as usize] = t as u32;
+                    fill[c] += 1;
+                }
+            }
+        }
+        Solid {
+            triangles,
+            lo,
+            cell,
+            dims,
+            starts,
+            entries,
+        }
     }
 
-    /// How far `q` lies outside the solid (mm); zero inside (by the winding number of
-    /// the surface around it) or when the model is open.
+    /// `q` lies inside the closed surface: the ray from it along +z crosses it an odd
+    /// number of times. A crossing on an edge or corner shared by triangles counts
+    /// once: each edge belongs to the one triangle on its top-left side.
+    fn contains(&self, q: DVec3) -> bool {
+        let p = q.truncate();
+        let k = ((p - self.lo) / self.cell).floor();
+        if k.x < 0.0 || k.y < 0.0 || k.x as usize >= self.dims[0] || k.y as usize >= self.dims[1] {
+            return false;
+        }
+        let c = k.x as usize + self.dims[0] * k.y as usize;
+        let mut crossings = 0;
+        for &t in &self.entries[self.starts[c] as usize..self.starts[c + 1] as usize] {
+            let [a, mut b, mut c] = self.triangles[t as usize];
+            let mut area = (b - a).truncate().perp_dot((c - a).truncate());
+            if area == 0.0 {
+                continue;
+            }
+            if area < 0.0 {
+                std::mem::swap(&mut b, &mut c);
+                area = -area;
+            }
+            let owns = |u: DVec3, v: DVec3| {
+                let w = (v - u).truncate().perp_dot(p - u.truncate());
+                let e = (v - u).truncate();
+                w > 0.0 || (w == 0.0 && (e.y < 0.0 || (e.y == 0.0 && e.x < 0.0)))
+            };
+            if owns(a, b) && owns(b, c) && owns(c, a) {
+                let weight = |u: DVec3, v: DVec3| (v - u).truncate().perp_dot(p - u.truncate());
+                let z = (weight(b, c) * a.z + weight(c, a) * b.z + weight(a, b) * c.z) / area;
+                if z > q.z {
+                    crossings += 1;
+                }
+            }
+        }
+        crossings % 2 == 1
+    }
+
+    /// How far `q` lies outside the solid (mm); zero inside, or when the model is open.
     fn outside_by(&self, q: DVec3) -> f64 {
-        if self.triangles.is_empty() {
-            return 0.0;
-        }
-        let mut solid_angle = 0.0;
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|p| p - q);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            let below = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-            solid_angle += 2.0 * a.dot(b.cross(c)).atan2(below);
-        }
-        if solid_angle >= 2.0 * PI {
+        if self.triangles.is_empty() || self.contains(q) {
             return 0.0;
         }
         self.triangles
@@ -591,7 +689,7 @@ fn check_apart(
 #[derive(Clone, Debug)]
 pub(super) struct Prism {
     /// The outer polygon's corners, then the inner one's.
-    corners: Vec<DVec3>,
+    pub(super) corners: Vec<DVec3>,
     /// Directions whose planes bound it (its faces' normals).
     normals: Vec<DVec3>,
     /// Directions of its edges.
