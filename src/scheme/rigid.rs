@@ -923,6 +923,29 @@ mod tests {
     }
 
     #[test]
+    fn rays_find_the_inside_even_through_shared_edges() {
+        let mesh = cube(100.0);
+        let solid = Solid::of(&mesh);
+        assert!(solid.contains(DVec3::splat(50.0)));
+        for q in [
+            DVec3::new(50.0, 50.0, 101.0),
+            DVec3::new(50.0, 50.0, -1.0),
+            DVec3::new(150.0, 50.0, 50.0),
+        ] {
+            assert!(!solid.contains(q), "{q}");
+        }
+        assert!((solid.outside_by(DVec3::new(50.0, 50.0, 101.0)) - 1.0).abs() < 1e-9);
+        assert!((solid.outside_by(DVec3::new(150.0, 50.0, 50.0)) - 50.0).abs() < 1e-9);
+        assert_eq!(solid.outside_by(DVec3::splat(50.0)), 0.0);
+        // Rays through the diagonal the top and bottom faces' triangles share cross
+        // each face once, not twice.
+        for t in [10.0, 25.0, 50.0, 75.0, 90.0] {
+            assert!(solid.contains(DVec3::new(t, t, 50.0)), "{t}");
+            assert!(solid.contains(DVec3::new(t, 100.0 - t, 50.0)), "{t}");
+        }
+    }
+
+    #[test]
     fn separating_axes_measure_overlap() {
         let frame = FaceFrame {
             origin: DVec3::ZERO,
