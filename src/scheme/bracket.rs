@@ -96,6 +96,8 @@ pub struct Bracket {
     pub arm_labels: [(FaceId, DVec3, DVec3); 2],
     /// Where the angle goes and which way it reads.
     pub angle_at: (DVec3, DVec3),
+    /// How far each arm's labels may slide along it to find room (mm).
+    pub slides: [f64; 2],
     /// The interior angle between the arms (radians): the edge's.
     pub angle: f64,
     /// The slot its tab needs in each of the two panels.
@@ -203,6 +205,7 @@ fn bracket_at(
             (fb, label_at(&arm_b, ub, nb, 0.35) + 0.5 * t * normal, ub),
         ],
         angle_at: (label_at(&arm_b, ub, nb, 0.8) + 0.5 * t * normal, ub),
+        slides: [0.3 * arm_a.length, 0.3 * arm_b.length],
         angle,
         slots: [arm_a.slot, arm_b.slot],
         arms: [
@@ -394,33 +397,33 @@ fn quads_meet(a: &[DVec3; 4], b: &[DVec3; 4]) -> bool {
 /// The panel of a bracket: its outline, its id and its two panels' ids on its arms,
 /// the angle between the arms engraved.
 pub fn bracket_panel(bracket: &Bracket, label_height: f64) -> Panel {
-    let label = |text: Name, (anchor, direction): (DVec3, DVec3), kind: LabelKind| Label {
-        text,
-        anchor,
-        direction,
-        height: label_height,
-        facet: 0,
-        kind,
-        on_edge: false,
-        slide: 0.0,
-    };
+    let label =
+        |text: Name, (anchor, direction): (DVec3, DVec3), kind: LabelKind, arm: usize| Label {
+            text,
+            anchor,
+            direction,
+            height: label_height,
+            facet: 0,
+            kind,
+            on_edge: false,
+            slide: bracket.slides[arm],
+        };
     let tenths = (bracket.angle.to_degrees() * 10.0).round() as u32;
     let mut labels = vec![label(
         Name::with_part(&BRACKET, bracket.edge.0, bracket.part),
         bracket.id_at,
         LabelKind::Panel,
+        0,
     )];
-    for (face, anchor, direction) in bracket.arm_labels {
-        labels.push(label(
-            Name::face(face.0),
-            (anchor, direction),
-            LabelKind::Partner,
-        ));
+    for (arm, (face, anchor, direction)) in bracket.arm_labels.into_iter().enumerate() {
+        let at = (anchor, direction);
+        labels.push(label(Name::face(face.0), at, LabelKind::Partner, arm));
     }
     labels.push(label(
         Name::with_part(&ANGLE, tenths / 10, tenths % 10),
         bracket.angle_at,
         LabelKind::Mark,
+        1,
     ));
     let facet: Loops = std::iter::once(0..bracket.points.len() as u32).collect();
     let source = Source {
