@@ -176,7 +176,7 @@ pub fn assembly_map(input: &MapInput) -> Vec<String> {
     let count = |named: &[bool]| named.iter().filter(|&&n| n).count();
     let on_overview = count(&named) - inside;
     let close_ups = close_up_pages(&map, &mut named);
-    let closer = count(&named) - on_overview;
+    let closer = count(&named) - inside - on_overview;
     let unnamed = input.panels.len() - count(&named);
     let key = key_text(
         input.panels,

@@ -312,13 +312,19 @@ impl Corner<'_> {
         }
         // Widen until clear (a cut that leaves a face no room ends the search), then
         // narrow down to the least cut that clears them.
-        let mut hi = self.thickness;
+        // A cut reaches at most to the middle of a corner's shorter side.
+        let deepest = 0.999
+            * faces
+                .iter()
+                .map(|(_, c)| c.reach)
+                .fold(f64::INFINITY, f64::min);
+        let mut hi = self.thickness.min(deepest);
         loop {
             let trial = self.cut(&faces, hi, outlines)?;
             match self.worst(&faces, &trial) {
                 None => break,
-                Some(error) if hi > 1e3 * self.thickness => return Err(error),
-                Some(_) => hi *= 2.0,
+                Some(error) if hi >= deepest || hi > 1e3 * self.thickness => return Err(error),
+                Some(_) => hi = (2.0 * hi).min(deepest),
             }
         }
         let mut lo = 0.0;
@@ -568,12 +574,12 @@ impl CornerFrame {
         let back = frame.to_2d(mesh.position(mesh.origin(into))) - at;
         let shorter = onward.length().min(back.length());
         let (onward, back) = (onward.normalize_or_zero(), back.normalize_or_zero());
-        let mut inward = (onward + back).normalize_or_zero();
-        if inward == DVec2::ZERO {
-            inward = onward.perp();
-        } else if back.perp_dot(onward) > 0.0 {
-            // A reflex corner: its bisector points out of the face.
-            inward = -inward;
+        let inward = (onward + back).normalize_or_zero();
+        if inward == DVec2::ZERO || back.perp_dot(onward) > 0.0 {
+            // A corner running straight on or reflex: a cut across it would take
+            // both its sides; its panel is left whole there (the last check, of
+            // every pair, still covers it).
+            return None;
         }
         let reach = 0.5 * shorter * inward.dot(onward).abs();
         Some(CornerFrame { at, inward, reach })
@@ -787,10 +793,10 @@ fn ear_triangles(poly: &[DVec2]) -> Vec<Vec<DVec2>> {
     triangles
 }
 
+/// `p` lies strictly inside triangle abc (a corner on a side, running straight on, does
+/// not stop an ear).
 fn inside_triangle(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> bool {
-    (b - a).perp_dot(p - a) >= 0.0
-        && (c - b).perp_dot(p - b) >= 0.0
-        && (a - c).perp_dot(p - c) >= 0.0
+    (b - a).perp_dot(p - a) > 0.0 && (c - b).perp_dot(p - b) > 0.0 && (a - c).perp_dot(p - c) > 0.0
 }
 
 /// How deep two sets of convex prisms overlap (mm): the deepest pair.
