@@ -559,46 +559,6 @@ fn clip_below(poly: &[DVec3], at: DVec3, normal: DVec3) -> Vec<DVec3> {
     out
 }
 
-/// A simple polygon (in a plane of `normal`, counter-clockwise about it) as triangles,
-/// by clipping ears.
-fn ears(poly: &[DVec3], normal: DVec3) -> Vec<Vec<DVec3>> {
-    let turn = |a: DVec3, b: DVec3, c: DVec3| (b - a).cross(c - b).dot(normal);
-    // Corners where the outline runs straight on (a tab's foot on its arm) are no ears.
-    let n = poly.len();
-    let mut left: Vec<DVec3> = (0..n)
-        .filter(|&k| turn(poly[(k + n - 1) % n], poly[k], poly[(k + 1) % n]).abs() > 1e-9)
-        .map(|k| poly[k])
-        .collect();
-    let mut out = Vec::new();
-    while left.len() > 3 {
-        let n = left.len();
-        let ear = (0..n).find(|&k| {
-            let (a, b, c) = (left[(k + n - 1) % n], left[k], left[(k + 1) % n]);
-            turn(a, b, c) > 1e-12
-                && left.iter().all(|&p| {
-                    p == a
-                        || p == b
-                        || p == c
-                        || !(turn(a, b, p) > 1e-12
-                            && turn(b, c, p) > 1e-12
-                            && turn(c, a, p) > 1e-12)
-                })
-        });
-        let Some(k) = ear else {
-            // Clipping can leave a corner running straight on: drop it.
-            let straight = (0..n)
-                .find(|&k| turn(left[(k + n - 1) % n], left[k], left[(k + 1) % n]).abs() <= 1e-9)
-                .expect("a simple polygon has an ear");
-            left.remove(straight);
-            continue;
-        };
-        out.push(vec![left[(k + n - 1) % n], left[k], left[(k + 1) % n]]);
-        left.remove(k);
-    }
-    out.push(left);
-    out
-}
-
 /// The brackets of a rigid build: each names its edge and both panels, its arms meet at
 /// the edge's angle within 0.1°, what of it lies in the material of its two panels lies
 /// in their slots, it passes into no other part, and every slot is T plus the
@@ -633,11 +593,12 @@ fn check_brackets(name: &str, r: &Rebuilt) {
         .brackets
         .iter()
         .map(|b| {
-            ears(&b.outer, b.normal)
+            // The bracket as triangles (the crate's ear clipping), each a convex part.
+            unfold::mesh::split::triangulate(&b.outer)
                 .into_iter()
-                .map(|outer| Part {
+                .map(|t| Part {
                     face: u32::MAX,
-                    outer,
+                    outer: t.map(|k| b.outer[k]).to_vec(),
                     normal: b.normal,
                 })
                 .collect()

@@ -704,17 +704,13 @@ pub(super) struct Prism {
 
 /// An outline as convex prisms: itself when convex, else its triangles.
 fn prisms_of(frame: &FaceFrame, outline: &FlatOutline, thickness: f64) -> Vec<Prism> {
-    let pieces = if is_convex(&outline.points) {
-        vec![outline.points.clone()]
-    } else {
-        ear_triangles(&outline.points)
-    };
-    pieces
-        .iter()
-        .map(|piece| {
-            let outer = piece.iter().map(|&p| frame.to_3d(p)).collect();
-            Prism::new(outer, frame.normal, thickness)
-        })
+    let outer: Vec<DVec3> = outline.points.iter().map(|&p| frame.to_3d(p)).collect();
+    if is_convex(&outline.points) {
+        return vec![Prism::new(outer, frame.normal, thickness)];
+    }
+    crate::mesh::split::triangulate(&outer)
+        .into_iter()
+        .map(|t| Prism::new(t.map(|k| outer[k]).to_vec(), frame.normal, thickness))
         .collect()
 }
 
@@ -766,37 +762,6 @@ fn is_convex(poly: &[DVec2]) -> bool {
         let (a, b, c) = (poly[k], poly[(k + 1) % n], poly[(k + 2) % n]);
         (b - a).perp_dot(c - b) >= -1e-12 * (b - a).length() * (c - b).length()
     })
-}
-
-/// A simple counter-clockwise polygon cut into triangles by clipping ears.
-fn ear_triangles(poly: &[DVec2]) -> Vec<Vec<DVec2>> {
-    let mut left: Vec<DVec2> = poly.to_vec();
-    let mut triangles = Vec::with_capacity(poly.len());
-    while left.len() > 3 {
-        let n = left.len();
-        let ear = (0..n).find(|&k| {
-            let (a, b, c) = (left[(k + n - 1) % n], left[k], left[(k + 1) % n]);
-            (b - a).perp_dot(c - b) > 0.0
-                && left
-                    .iter()
-                    .all(|&p| p == a || p == b || p == c || !inside_triangle(p, a, b, c))
-        });
-        let Some(k) = ear else {
-            // Only rounding leaves no ear: the rest as one piece.
-            break;
-        };
-        let n = left.len();
-        triangles.push(vec![left[(k + n - 1) % n], left[k], left[(k + 1) % n]]);
-        left.remove(k);
-    }
-    triangles.push(left);
-    triangles
-}
-
-/// `p` lies strictly inside triangle abc (a corner on a side, running straight on, does
-/// not stop an ear).
-fn inside_triangle(p: DVec2, a: DVec2, b: DVec2, c: DVec2) -> bool {
-    (b - a).perp_dot(p - a) > 0.0 && (c - b).perp_dot(p - b) > 0.0 && (a - c).perp_dot(p - c) > 0.0
 }
 
 /// How deep two sets of convex prisms overlap (mm): the deepest pair.
