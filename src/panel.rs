@@ -32,6 +32,8 @@ pub struct IdKind {
     pub noun: &'static str,
     /// The manifest field of a panel's part number, for ids with one (`C3.2`).
     pub part_noun: &'static str,
+    /// The manifest's `layer` of a panel so named (`outer`, `inner`), or empty.
+    pub layer: &'static str,
 }
 
 /// Faces: `F12`, a face panel's id or a face mark.
@@ -40,6 +42,7 @@ pub static FACE: IdKind = IdKind {
     legend: "face (a face panel, or the mark of a face)",
     noun: "face",
     part_noun: "",
+    layer: "",
 };
 
 /// Edges: `E123`, an edge panel's id.
@@ -48,6 +51,7 @@ pub static EDGE: IdKind = IdKind {
     legend: "edge panel",
     noun: "edge",
     part_noun: "",
+    layer: "",
 };
 
 /// Vertices: `V7`, a corner mark.
@@ -56,6 +60,7 @@ pub static VERTEX: IdKind = IdKind {
     legend: "vertex mark",
     noun: "vertex",
     part_noun: "",
+    layer: "",
 };
 
 /// A printed name: a panel's id, or what a label says: a kind's letter, a number and,
@@ -1452,6 +1457,7 @@ mod tests {
             legend: "cycle",
             noun: "cycle",
             part_noun: "segment",
+            layer: "",
         };
         assert_eq!(Name::new(&CYCLE, 3).to_string(), "C3");
         assert_eq!(Name::with_part(&CYCLE, 3, 2).to_string(), "C3.2");
@@ -1460,6 +1466,7 @@ mod tests {
             legend: "match number",
             noun: "match",
             part_noun: "",
+            layer: "",
         };
         assert_eq!(Name::new(&BARE, 17).to_string(), "17");
         assert_eq!(Source::edge(5).id.to_string(), "E5");

@@ -10,6 +10,7 @@ mod build_half_edge;
 mod build_net;
 mod build_quad_edge;
 mod build_rigid;
+mod build_sandwich;
 mod build_strip;
 mod build_winged_edge;
 mod build_woven;

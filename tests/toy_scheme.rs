@@ -157,6 +157,7 @@ static PAIR: IdKind = IdKind {
     legend: "pair of faces (folds along its middle)",
     noun: "pair",
     part_noun: "",
+    layer: "",
 };
 
 #[derive(Debug)]

@@ -68,7 +68,9 @@ pub fn load_config(path: &Path, registry: &Registry) -> Result<BuildOptions> {
     let mut layers = LayerSettings::default();
     for (key, value) in entries {
         let name = key.get_ref().as_ref();
-        if name == "layers" {
+        // `layers` is both the edge schemes' layer count (a number) and the table of
+        // laser kinds.
+        if name == "layers" && !matches!(value.get_ref(), DeValue::Integer(_)) {
             read_layers(value, &mut layers).map_err(|(span, why)| at(Some(span), why))?;
             continue;
         }
@@ -118,7 +120,7 @@ fn read_layers(
         return Err((
             value.span(),
             format!(
-                "layers is a table of kinds ({kinds}): write [layers.cut] and its keys below it"
+                "layers is a table of kinds ({kinds}): write [layers.cut] and its keys below it (or, for the edge schemes' sandwich, layers = 2)"
             ),
         ));
     };

@@ -303,7 +303,8 @@ pub fn panel_entries(
 }
 
 /// A panel's source for the manifest: its number under its kind's noun (`"edge": 7`),
-/// its part's number under the kind's part noun (`"segment": 2`), then the mesh
+/// its part's number under the kind's part noun (`"segment": 2`), its layer
+/// (`"layer": "inner"`) for a kind that names one, then the mesh
 /// elements it covers (`face` and `input_face`, `edge`, or `faces` and `input_faces`:
 /// the face in the input file is `null` for one made by splitting or simplification),
 /// each field written once: a face panel named after its face gives `"face"` once.
@@ -322,6 +323,9 @@ pub fn panel_source(
     push(id.kind.noun, id.number.into());
     if id.part > 0 {
         push(id.kind.part_noun, id.part.into());
+    }
+    if !id.kind.layer.is_empty() {
+        push("layer", id.kind.layer.into());
     }
     match source.covers {
         Covers::Face(f) => {

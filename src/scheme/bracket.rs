@@ -19,6 +19,7 @@ pub static BRACKET: IdKind = IdKind {
     legend: "bracket (edge.bracket)",
     noun: "bracket",
     part_noun: "bracket",
+    layer: "",
 };
 
 /// The kind of mark engraved on a bracket: the angle between its arms, in degrees
@@ -28,6 +29,7 @@ pub static ANGLE: IdKind = IdKind {
     legend: "bracket angle (degrees)",
     noun: "angle",
     part_noun: "tenth",
+    layer: "",
 };
 
 /// The length of an arm where its panel has room (mm): enough for its labels.

@@ -38,12 +38,17 @@ const FLAP_SCALE: f64 = 0.5;
 /// `--samples`.
 const SAMPLES: u32 = 4;
 
+/// `--layers`.
+const LAYERS: u32 = 1;
+
 /// The defaults of the band options, for the edge schemes' `options()`.
-pub fn band_defaults() -> [OptionDefault; 3] {
+pub fn band_defaults() -> [OptionDefault; 5] {
     [
         OptionDefault::value("bridge-scale", BRIDGE_SCALE),
         OptionDefault::value("flap-scale", FLAP_SCALE),
         OptionDefault::value("samples", SAMPLES),
+        super::thickness_default(),
+        OptionDefault::value("layers", LAYERS),
     ]
 }
 
@@ -63,6 +68,16 @@ pub struct BandArgs {
     /// Strips of the Bézier bend; every ruling between two strips is a score line.
     #[arg(long, value_name = "N")]
     pub samples: Option<u32>,
+
+    /// Card thickness, with a unit, for `--layers 2`: the inner layer lies this far
+    /// inside the outer one.
+    #[arg(long, value_name = "LENGTH")]
+    pub thickness: Option<String>,
+
+    /// 1, or 2 for the two-layer sandwich: every panel cut twice, an outer and an
+    /// inner layer glued into one shell, their flaps lapped at the face corners.
+    #[arg(long, value_name = "N")]
+    pub layers: Option<u32>,
 }
 
 impl BandArgs {
@@ -72,12 +87,21 @@ impl BandArgs {
         if !(1..=64).contains(&samples) {
             return Err(format!("--samples: {samples} must be between 1 and 64"));
         }
+        let thickness = super::thickness("thickness", self.thickness.as_deref(), "0mm", &panel)?;
+        let sandwich = match (self.layers.unwrap_or(LAYERS), thickness > 0.0) {
+            (1, false) => None,
+            (2, true) => Some(thickness),
+            (1, true) => return Err("--thickness: the edge schemes take a thickness for the two-layer sandwich; add --layers 2 (or leave --thickness out for single panels)".to_string()),
+            (2, false) => return Err("--layers 2: the sandwich needs the card's --thickness (--thickness 0.5mm)".to_string()),
+            (layers, _) => return Err(format!("--layers: {layers} must be 1 or 2")),
+        };
         Ok(EdgeOptions {
             panel,
             bridge_scale: fraction("bridge-scale", self.bridge_scale, BRIDGE_SCALE)?,
             flap_scale: fraction("flap-scale", self.flap_scale, FLAP_SCALE)?,
             samples,
             deep_flaps: true,
+            sandwich,
         })
     }
 }
@@ -96,6 +120,8 @@ pub struct EdgeOptions {
     /// Whether flaps may grow past the face's other corners (notched round their
     /// pins); not for a model too detailed for its fasteners (see [`edge_scheme`]).
     pub deep_flaps: bool,
+    /// The two-layer sandwich's card thickness (mm), or `None` for single panels.
+    pub sandwich: Option<f64>,
 }
 
 impl EdgeOptions {
@@ -105,6 +131,10 @@ impl EdgeOptions {
         params.push("bridge_scale", self.bridge_scale);
         params.push("flap_scale", self.flap_scale);
         params.push("samples", self.samples);
+        if let Some(thickness) = self.sandwich {
+            params.push("thickness", crate::record::round4(thickness));
+            params.push("layers", 2);
+        }
         params
     }
 }
@@ -505,13 +535,15 @@ pub fn notch_flap(flap: &[DVec2], pins: &[DVec2], clear: f64, keep: f64) -> Opti
 
 /// An edge scheme end to end: each face's flaps from `face_flaps` (in parallel, in
 /// face order), widened where corners need it (`widen_bands`), then the panels, the
-/// connection count (one per face corner) and the report lines.
+/// connection count (one per face corner) and the report lines; with `--layers 2`
+/// both layers of every panel ([`super::sandwich`]), or the refusal of a bend too tight
+/// for the card.
 pub fn edge_scheme(
     mesh: &Mesh,
     options: &EdgeOptions,
     widen: WidenFor,
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
-) -> super::SchemeOutput {
+) -> Result<super::SchemeOutput, super::SchemeError> {
     // Flaps no deeper than the face's other corners first; then, for the faces whose
     // corners are short of holes, flaps that may grow past them (`keep_if_fastened`).
     let shallow = EdgeOptions {
@@ -522,7 +554,9 @@ pub fn edge_scheme(
         .into_par_iter()
         .map(|f| face_flaps(mesh, FaceId(f), &shallow))
         .collect();
-    if options.deep_flaps {
+    // Deep flaps are notched round the pins they pass; lapped into two layers, a
+    // notch can pinch a flap to a thread, so the sandwich keeps flaps shallow.
+    if options.deep_flaps && options.sandwich.is_none() {
         let deeper: Vec<(usize, FaceFlaps)> = (0..faces.len())
             .into_par_iter()
             .filter(|&k| !faces[k].bare.is_empty() || faces[k].reduced > 0)
@@ -531,15 +565,23 @@ pub fn edge_scheme(
         keep_if_fastened(&mut faces, deeper);
     }
     widen_bands(mesh, options, widen, &face_flaps, &mut faces);
-    let panels = edge_panels(mesh, &faces, options);
     let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
-    super::SchemeOutput {
+    let mut notes = edge_scheme_notes(mesh, &faces, connections, options);
+    let panels = match options.sandwich {
+        Some(t) => {
+            let sandwich = super::sandwich::sandwich_panels(mesh, &faces, options, t)?;
+            notes.extend(sandwich.notes);
+            sandwich.panels
+        }
+        None => edge_panels(mesh, &faces, options),
+    };
+    Ok(super::SchemeOutput {
         panels,
         connections,
-        notes: edge_scheme_notes(mesh, &faces, connections, options),
+        notes,
         unfastened: unfastened(mesh, &faces),
         ..super::SchemeOutput::default()
-    }
+    })
 }
 
 /// Widens the bands of the faces whose corners need room ([`widened_band`]), where
@@ -658,7 +700,7 @@ pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &EdgeOptions) -> P
 }
 
 /// Quadratic Bézier point.
-fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
+pub(super) fn bezier(p0: DVec3, p1: DVec3, p2: DVec3, t: f64) -> DVec3 {
     let s = 1.0 - t;
     s * s * p0 + 2.0 * s * t * p1 + t * t * p2
 }
@@ -822,7 +864,7 @@ const FLAP_LABELS: usize = 5;
 /// Labels on a flap: the partner panel's id toward each of its two corners, the vertex
 /// id at each corner's pins, the face id in the middle (in that priority).
 #[allow(clippy::too_many_arguments)]
-fn flap_labels(
+pub(super) fn flap_labels(
     mesh: &Mesh,
     part: &FaceFlaps,
     face: FaceId,

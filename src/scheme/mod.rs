@@ -14,6 +14,7 @@ pub mod half_edge;
 pub mod net;
 pub mod quad_edge;
 pub mod rigid;
+pub mod sandwich;
 pub mod strip;
 pub mod winged_edge;
 pub mod woven;
@@ -501,7 +502,10 @@ impl SchemeError {
 
 /// `--thickness` as `--help` states its default (the schemes that take it differ).
 pub(super) fn thickness_default() -> crate::option_default::OptionDefault {
-    crate::option_default::OptionDefault::words("thickness", "0mm for half-edge, 0.1in for woven")
+    crate::option_default::OptionDefault::words(
+        "thickness",
+        "0mm for half-edge, quad-edge and winged-edge, 0.1in for woven",
+    )
 }
 
 /// A material thickness as given (`text`, else `default`), in mm: zero or more, and

@@ -65,6 +65,7 @@ pub static ISLAND: IdKind = IdKind {
     legend: "net island",
     noun: "island",
     part_noun: "",
+    layer: "",
 };
 
 /// Match numbers: `17`, the same on both sides of a cut, so its two sides are found.
@@ -73,6 +74,7 @@ pub static MATCH: IdKind = IdKind {
     legend: "a bare number marks the two sides of one cut",
     noun: "match",
     part_noun: "",
+    layer: "",
 };
 
 /// The net scheme: islands of faces joined along folds, glue tabs on the cuts.

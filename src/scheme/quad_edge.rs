@@ -77,7 +77,7 @@ impl Configured for EdgeOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        Ok(panels(mesh, self))
+        panels(mesh, self)
     }
 
     fn params(&self) -> Params {
@@ -86,7 +86,7 @@ impl Configured for EdgeOptions {
 }
 
 /// Builds the edge panels of a mesh whose faces are planar and convex.
-pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> SchemeOutput {
+pub fn panels(mesh: &Mesh, options: &EdgeOptions) -> Result<SchemeOutput, SchemeError> {
     edge_scheme(mesh, options, WidenFor::Short, flaps_in_band)
 }
 
@@ -382,6 +382,7 @@ mod tests {
             flap_scale,
             samples: 4,
             deep_flaps: true,
+            sandwich: None,
         }
     }
 
@@ -459,7 +460,8 @@ mod tests {
 
     #[test]
     fn an_interior_edge_panel_is_a_flap_a_developable_bend_and_a_flap() {
-        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        let out =
+            panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5)).expect("single panels build");
         let panel = out.panels.get(2);
         assert_eq!(panel.id().to_string(), "E2");
         // Rails at v1 and v0 from face 0's band corner through b·v + (1 − b)·m
@@ -514,7 +516,8 @@ mod tests {
 
     #[test]
     fn a_boundary_edge_panel_is_its_one_flap_sharing_the_corner_pin() {
-        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        let out =
+            panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5)).expect("single panels build");
         let panel = out.panels.get(0);
         assert_eq!(panel.id().to_string(), "E0");
         // Band edge 0 of face 0 and its flap's inner corners.
@@ -536,7 +539,8 @@ mod tests {
 
     #[test]
     fn there_is_a_panel_per_edge_and_a_connection_per_face_corner() {
-        let out = panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5));
+        let out =
+            panels(&two_triangles(FOLDED), &options(1, 0.5, 0.5)).expect("single panels build");
         // 5 edges; 2 triangles have 6 corners.
         assert_eq!((out.panels.len(), out.connections), (5, 6));
         let ids: Vec<String> = out.panels.iter().map(|p| p.id().to_string()).collect();
@@ -548,7 +552,7 @@ mod tests {
         // The closed tetrahedron: 6 edges, 4 triangles of 3 corners, no note.
         let mut mesh = tetrahedron();
         mesh.scale(20.0);
-        let out = panels(&mesh, &options(0, 0.5, 0.5));
+        let out = panels(&mesh, &options(0, 0.5, 0.5)).expect("single panels build");
         assert_eq!((out.panels.len(), out.connections), (6, 12));
         assert!(out.notes.is_empty(), "{:?}", out.notes);
     }

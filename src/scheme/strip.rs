@@ -35,6 +35,7 @@ pub static STRIP: IdKind = IdKind {
     legend: "strip piece (strip.piece)",
     noun: "strip",
     part_noun: "piece",
+    layer: "",
 };
 
 /// The default `--max-deviation`: a percentage of the built model's bounding-box

@@ -104,7 +104,7 @@ impl Configured for WingedEdgeOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        Ok(panels(mesh, self))
+        panels(mesh, self)
     }
 
     fn params(&self) -> Params {
@@ -115,7 +115,7 @@ impl Configured for WingedEdgeOptions {
 }
 
 /// Builds the winged edge panels of a mesh whose faces are planar and convex.
-pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> SchemeOutput {
+pub fn panels(mesh: &Mesh, options: &WingedEdgeOptions) -> Result<SchemeOutput, SchemeError> {
     let shift = options.shift;
     // Where a corner holds no hole, the face's band widens as in quad-edge (the
     // wings do not grow); not for fewer holes than wanted, which the two shared
@@ -278,6 +278,7 @@ mod tests {
                 flap_scale: 0.5,
                 samples: 4,
                 deep_flaps: true,
+                sandwich: None,
             },
             shift,
         }
@@ -375,7 +376,7 @@ mod tests {
 
     #[test]
     fn the_hinge_panel_has_the_quad_edge_bend_and_winged_flaps() {
-        let out = panels(&two_triangles(FOLDED), &options(1, 0));
+        let out = panels(&two_triangles(FOLDED), &options(1, 0)).expect("single panels build");
         // A panel per edge, a connection per face corner, as quad-edge.
         assert_eq!((out.panels.len(), out.connections), (5, 6));
         let panel = out.panels.get(2);

@@ -362,6 +362,7 @@ pub static CYCLE: IdKind = IdKind {
     legend: "woven cycle (C3.2: its segment 2)",
     noun: "cycle",
     part_noun: "segment",
+    layer: "",
 };
 
 /// The printed id of a cycle.
