@@ -478,6 +478,19 @@ fn the_sandwich_options_are_checked() {
             "must be 1 or 2",
         ),
         (vec!["--connectors", "bracket"], "half-edge"),
+        (
+            vec![
+                "--scheme",
+                "winged-edge",
+                "--thickness",
+                "1mm",
+                "--layers",
+                "2",
+                "--shift",
+                "1",
+            ],
+            "--shift",
+        ),
     ] {
         let mut args = vec![
             cube.to_str().unwrap(),

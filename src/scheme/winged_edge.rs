@@ -91,10 +91,13 @@ impl Scheme for WingedEdge {
         if !(-1..=1).contains(&shift) {
             return Err(format!("--shift: {shift} must be -1, 0 or 1"));
         }
-        Ok(Box::new(WingedEdgeOptions {
-            edge: args.band.resolve(panel)?,
-            shift,
-        }))
+        let edge = args.band.resolve(panel)?;
+        if shift != 0 && edge.sandwich.is_some() {
+            // A full wing covers the whole of the next sector, so in one of the two
+            // layers a flap would keep only its wing, which hangs on nothing.
+            return Err(format!("--shift {shift}: in the two-layer sandwich (--layers 2) the wings lap only as half wings; leave --shift at 0"));
+        }
+        Ok(Box::new(WingedEdgeOptions { edge, shift }))
     }
 }
 
