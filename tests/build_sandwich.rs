@@ -505,3 +505,46 @@ fn the_sandwich_options_are_checked() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn an_open_mesh_in_two_layers_counts_the_boundary_panels_cut_once() {
+    let tmp = TempDir::new().unwrap();
+    let grid = model("open-grid");
+    let out = tmp.path().join("out");
+    let extra = ["--format", "svg,dxf", "--thickness", "1mm", "--layers", "2"];
+    let m = build("winged-edge", &grid, "400mm", &out, &extra);
+    check_output(
+        &grid,
+        &out,
+        &m,
+        "open grid (winged-edge)",
+        DxfCheck::FirstAndLast,
+        |e| e["id"].as_str().unwrap().to_string(),
+    );
+    // A boundary edge's panel is its flap alone; where the neighbouring flaps take its
+    // ground in a layer, that layer has no part of it, and the report counts them.
+    let (edges, panels) = (count(&m, "input.edges"), count(&m, "counts.panels"));
+    let run = unfold([
+        grid.to_str().unwrap(),
+        "--scheme",
+        "winged-edge",
+        "--size",
+        "400mm",
+        "--thickness",
+        "1mm",
+        "--layers",
+        "2",
+        "--build-anyway",
+        "--out",
+        tmp.path().join("again").to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, Some(0), "{}", run.stderr);
+    let line = run
+        .stderr
+        .lines()
+        .find(|l| l.contains("boundary panels are cut in one layer only"))
+        .expect("the note of panels cut once");
+    let once = number_after(line, "note: ").unwrap();
+    assert!(once > 0, "{line}");
+    assert_eq!(panels, 2 * edges - once);
+}

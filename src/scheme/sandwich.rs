@@ -483,7 +483,8 @@ fn bend_of(
 }
 
 /// What a sandwich build makes of the faces' flaps: both layers of every edge panel
-/// (outer at 2e, inner at 2e + 1) and the report lines.
+/// (outer, then inner, in edge order; a boundary panel whose flap is lapped away in a
+/// layer has no part there) and the report lines.
 pub struct Sandwich {
     /// The panels.
     pub panels: Panels,
@@ -528,9 +529,18 @@ pub fn sandwich_panels(
         .into_par_iter()
         .map(|f| face_layers(mesh, FaceId(f as u32), &faces[f]))
         .collect();
-    let panels = Panels::build(2 * mesh.edge_count(), |i| {
-        ctx.layer_panel(EdgeId((i / 2) as u32), i % 2 == 1, &layers)
-    });
+    // A boundary edge's panel is its flap alone: where lapping gives that flap's
+    // ground in one layer to its neighbours, the panel has no part in that layer.
+    let layer_panels: Vec<Option<Panel>> = (0..2 * mesh.edge_count())
+        .into_par_iter()
+        .map(|i| ctx.layer_panel(EdgeId((i / 2) as u32), i % 2 == 1, &layers))
+        .collect();
+    let single = layer_panels.iter().filter(|p| p.is_none()).count();
+    let mut panels = Panels::new();
+    for panel in layer_panels.iter().flatten() {
+        panels.push(panel.view());
+    }
+    drop(layer_panels);
     let strips: Vec<usize> = bends
         .iter()
         .flatten()
@@ -552,6 +562,11 @@ pub fn sandwich_panels(
             strips.iter().max().unwrap_or(&0),
             fmt_num((max_strip_turn(t).to_degrees() * 10.0).floor() / 10.0),
             fmt_num(t)
+        ));
+    }
+    if single > 0 {
+        notes.push(format!(
+            "{single} boundary panels are cut in one layer only: the neighbouring flaps cover their flap's ground in the other"
         ));
     }
     let dropped: f64 = layers.iter().map(|l| l.dropped).sum();
@@ -653,7 +668,7 @@ impl Context<'_> {
     }
 
     /// One layer of edge `e`'s panel: flap in f, bend strips, flap in the face across.
-    fn layer_panel(&self, e: EdgeId, inner: bool, layers: &[FaceLayers]) -> Panel {
+    fn layer_panel(&self, e: EdgeId, inner: bool, layers: &[FaceLayers]) -> Option<Panel> {
         let (h, f, k) = self.side(e);
         let depth = if inner { self.t } else { 0.0 };
         let shift_f = -depth * layers[f.index()].normal;
@@ -737,6 +752,9 @@ impl Context<'_> {
             );
             labels[first..].iter_mut().for_each(|l| l.anchor += shift_g);
         }
+        if facets.is_empty() {
+            return None;
+        }
         let strip_facets: Vec<u32> = (first_strip..far_facet).collect();
         outer_partners(&mut labels);
         labels.insert(0, self.id_label(id, &vertices, &facets, &strip_facets, n));
@@ -745,7 +763,13 @@ impl Context<'_> {
         } else {
             Covers::Edge(e.0)
         };
-        Panel::new(Source { id, covers }, vertices, facets, holes, labels)
+        Some(Panel::new(
+            Source { id, covers },
+            vertices,
+            facets,
+            holes,
+            labels,
+        ))
     }
 
     /// Edge `e`'s rails `depth` inside the surface (vertex 2i at v, 2i + 1 at v′, at the
