@@ -632,6 +632,26 @@ fn outer_partners(labels: &mut [Label]) {
     }
 }
 
+/// The `n` bend strips between rails 2i (at v) and 2i + 1 (at v′), the first and the
+/// last with the fold points a lapped flap adds on their outer rulings.
+fn strip_loops(n: usize, inserted_f: &[u32], inserted_g: &[u32]) -> Vec<Vec<u32>> {
+    let (rail_v, rail_w) = (|i: usize| 2 * i as u32, |i: usize| 2 * i as u32 + 1);
+    (0..n)
+        .map(|i| {
+            let mut facet = vec![rail_w(i)];
+            if i == 0 {
+                facet.extend(inserted_f);
+            }
+            facet.extend([rail_v(i), rail_v(i + 1)]);
+            if i + 1 == n {
+                facet.extend(inserted_g);
+            }
+            facet.push(rail_w(i + 1));
+            facet
+        })
+        .collect()
+}
+
 /// What every layer panel of a sandwich build reads.
 struct Context<'a> {
     mesh: &'a Mesh,
@@ -724,16 +744,7 @@ impl Context<'_> {
             );
             labels.iter_mut().for_each(|l| l.anchor += shift_f);
         }
-        for i in 0..n {
-            let mut facet = vec![rail_w(i)];
-            if i == 0 {
-                facet.extend(&inserted_f);
-            }
-            facet.extend([rail_v(i), rail_v(i + 1)]);
-            if i + 1 == n {
-                facet.extend(&inserted_g);
-            }
-            facet.push(rail_w(i + 1));
+        for facet in strip_loops(n, &inserted_f, &inserted_g) {
             facets.push(facet);
         }
         if let (Some(lp), Some((g, k2, shift_g, _))) = (far_loop, far) {
