@@ -386,9 +386,9 @@ fn a_simplified_shared_model_in_two_layers_of_card() {
         return;
     };
     let tmp = TempDir::new().unwrap();
-    // About 300 faces: 450 edges of a closed triangle mesh; 0.5 mm card at 700 mm.
+    // About 300 faces: 450 edges of a closed triangle mesh; 0.3 mm card at 700 mm.
     let simple = simplified_obj(&shared.join("spot.obj"), 450, true, tmp.path());
-    let (bends, width, gap) = check_sandwich("quad-edge", &simple, "700mm", 0.5, tmp.path());
+    let (bends, width, gap) = check_sandwich("quad-edge", &simple, "700mm", 0.3, tmp.path());
     eprintln!(
         "spot: {bends} bends, widths within {width:.4} mm of T·θ, layers within {gap:.4} mm of T"
     );
@@ -425,7 +425,7 @@ fn a_bend_tighter_than_the_card_is_refused_with_what_rounds_it() {
             "--size",
             size,
             "--thickness",
-            "3mm",
+            "1mm",
             "--layers",
             "2",
             "--holes",
@@ -437,10 +437,11 @@ fn a_bend_tighter_than_the_card_is_refused_with_what_rounds_it() {
         args.extend(extra);
         unfold(args)
     };
-    // A 10 mm cube's bends turn on a radius of 1.8 mm.
+    // A 10 mm cube's bends turn on a radius of 1.8 mm, short of the 2 mm of two layers
+    // of 1 mm card.
     let refused = run("10mm", &[]);
     assert_refusal(
-        "3 mm card on a 10 mm cube",
+        "1 mm card on a 10 mm cube",
         &refused,
         2,
         &["E0", "1.768 mm", "--face-scale", "--size"],

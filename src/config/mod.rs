@@ -834,6 +834,11 @@ impl BuildOptions {
                 defaults::LABEL_HEIGHT,
             )?,
             panel_limit: Some(sheet.panel_limit(nest.search.rotations)),
+            scale: self
+                .model
+                .scale
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .unwrap_or(defaults::SCALE),
         };
         let options = scheme
             .configure(&self.scheme_values, panel)

@@ -544,8 +544,40 @@ pub fn edge_scheme(
     widen: WidenFor,
     face_flaps: impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync,
 ) -> Result<super::SchemeOutput, super::SchemeError> {
-    // Flaps no deeper than the face's other corners first; then, for the faces whose
-    // corners are short of holes, flaps that may grow past them (`keep_if_fastened`).
+    let faces = all_flaps(mesh, options, widen, &face_flaps);
+    let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
+    let mut notes = edge_scheme_notes(mesh, &faces, connections, options);
+    let panels = match options.sandwich {
+        Some(t) => {
+            // A bend too tight for the card is refused with a size or face scale that
+            // this scheme, rebuilt so, finds round enough.
+            let tightest = |m: &Mesh, o: &EdgeOptions| {
+                super::sandwich::tightest_bend(m, &all_flaps(m, o, widen, &face_flaps), o, t)
+            };
+            let sandwich = super::sandwich::sandwich_panels(mesh, &faces, options, t, tightest)?;
+            notes.extend(sandwich.notes);
+            sandwich.panels
+        }
+        None => edge_panels(mesh, &faces, options),
+    };
+    Ok(super::SchemeOutput {
+        panels,
+        connections,
+        notes,
+        unfastened: unfastened(mesh, &faces),
+        ..super::SchemeOutput::default()
+    })
+}
+
+/// Every face's flaps: no deeper than the face's other corners first; then, for the
+/// faces whose corners are short of holes, flaps that may grow past them
+/// (`keep_if_fastened`); then bands widened where corners still need room.
+fn all_flaps(
+    mesh: &Mesh,
+    options: &EdgeOptions,
+    widen: WidenFor,
+    face_flaps: &(impl Fn(&Mesh, FaceId, &EdgeOptions) -> FaceFlaps + Sync),
+) -> Vec<FaceFlaps> {
     let shallow = EdgeOptions {
         deep_flaps: false,
         ..options.clone()
@@ -564,24 +596,8 @@ pub fn edge_scheme(
             .collect();
         keep_if_fastened(&mut faces, deeper);
     }
-    widen_bands(mesh, options, widen, &face_flaps, &mut faces);
-    let connections: usize = faces.iter().map(FaceFlaps::corners).sum();
-    let mut notes = edge_scheme_notes(mesh, &faces, connections, options);
-    let panels = match options.sandwich {
-        Some(t) => {
-            let sandwich = super::sandwich::sandwich_panels(mesh, &faces, options, t)?;
-            notes.extend(sandwich.notes);
-            sandwich.panels
-        }
-        None => edge_panels(mesh, &faces, options),
-    };
-    Ok(super::SchemeOutput {
-        panels,
-        connections,
-        notes,
-        unfastened: unfastened(mesh, &faces),
-        ..super::SchemeOutput::default()
-    })
+    widen_bands(mesh, options, widen, face_flaps, &mut faces);
+    faces
 }
 
 /// Widens the bands of the faces whose corners need room ([`widened_band`]), where

@@ -529,7 +529,8 @@ fn outline_labels(
 /// pass through each other, meeting edge to edge.
 fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOutput, SchemeError> {
     let t = options.thickness;
-    let rigid = super::rigid::rigid_panels(mesh, t).map_err(|e| too_thick(mesh, t, &e))?;
+    let rigid = super::rigid::rigid_panels(mesh, t)
+        .map_err(|e| too_thick(mesh, t, options.panel.scale, &e))?;
     let (brackets, bare) = match options.brackets {
         Some(sizes) => super::bracket::clear_brackets(mesh, &rigid.outlines, sizes),
         None => (Vec::new(), Vec::new()),
@@ -614,7 +615,12 @@ fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOut
 
 /// The refusal of a thickness the model cannot take at its size, naming the thickness
 /// that fits and the size that takes this one.
-fn too_thick(mesh: &Mesh, thickness: f64, error: &super::rigid::RigidError) -> SchemeError {
+fn too_thick(
+    mesh: &Mesh,
+    thickness: f64,
+    scale: f64,
+    error: &super::rigid::RigidError,
+) -> SchemeError {
     use super::rigid::RigidError;
     let what = match error {
         RigidError::NoRoom { face } => format!(
@@ -642,8 +648,9 @@ fn too_thick(mesh: &Mesh, thickness: f64, error: &super::rigid::RigidError) -> S
             fmt_num(thickness)
         ));
     }
-    // Scaling the model up by k takes k times the thickness.
-    let size = mesh.longest_side() * thickness / fits;
+    // Scaling the model up by k takes k times the thickness (`--size` comes before
+    // `--scale`).
+    let size = mesh.longest_side() * thickness / fits / scale;
     SchemeError::Options(format!(
         "--thickness {}mm is too thick for this model at this size: {what}; --thickness {}mm fits, or --size {}mm takes it",
         fmt_num(thickness),
@@ -801,6 +808,7 @@ mod tests {
                 hole_margin: 0.5,
                 label_height: 2.0,
                 panel_limit: None,
+                scale: 1.0,
             },
             tabs: true,
             tab_height,

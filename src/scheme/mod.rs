@@ -148,6 +148,9 @@ pub struct PanelOptions {
     /// The largest panel the layout can take; schemes that can cut long panels
     /// (woven ribbons) cut them to fit. `None`: no limit.
     pub panel_limit: Option<PanelLimit>,
+    /// `--scale`, applied after `--size`: a scheme that names a `--size` divides the
+    /// built size by it.
+    pub scale: f64,
 }
 
 /// The largest panel a sheet takes: its bounding box in one of `rotations` equal

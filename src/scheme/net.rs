@@ -1534,6 +1534,7 @@ mod tests {
                 hole_margin: 0.5,
                 label_height: 2.0,
                 panel_limit: None,
+                scale: 1.0,
             },
             tab_height: 5.0,
             max_island_faces,

@@ -377,6 +377,7 @@ mod tests {
                 hole_margin,
                 label_height: 2.0,
                 panel_limit: None,
+                scale: 1.0,
             },
             bridge_scale: 0.5,
             flap_scale,

@@ -17,8 +17,8 @@
 //!   the latest the inner). So every covered point of a face has one outer and one
 //!   inner layer over it: the shell is 2T thick everywhere, each pin goes through both
 //!   layers, and the seams of the two layers are staggered, a lap joint.
-//! - A convex bend whose curve turns tighter than T has no inner offset (it would fold
-//!   back on itself): refused, with the size or face scale that rounds it enough.
+//! - A convex bend whose curve turns tighter than 2T (the inner card's inside face) would
+//!   fold back on itself there: refused, with the size or face scale that rounds it.
 
 use glam::{DVec2, DVec3};
 use i_overlay::core::fill_rule::FillRule;
@@ -494,18 +494,19 @@ pub struct Sandwich {
 
 /// Both layers of every edge panel of card `t` thick, or the refusal of a bend too
 /// tight for the card.
+/// `tightest(mesh, options)` is the scheme's [`tightest_bend`] rebuilt for another
+/// mesh or options, to find the fixes a refusal names.
 pub fn sandwich_panels(
     mesh: &Mesh,
     faces: &[FaceFlaps],
     options: &EdgeOptions,
     t: f64,
+    tightest: impl Fn(&Mesh, &EdgeOptions) -> Option<(usize, f64)>,
 ) -> Result<Sandwich, SchemeError> {
-    let mut corner_of = vec![0u32; mesh.half_edge_count()];
-    for f in mesh.faces() {
-        for (k, h) in mesh.face_half_edges(f).enumerate() {
-            corner_of[h.index()] = k as u32;
-        }
+    if let Some(bend) = tightest_bend(mesh, faces, options, t) {
+        return Err(too_tight(mesh, options, t, bend, tightest));
     }
+    let corner_of = corners_of(mesh);
     let ctx = Context {
         mesh,
         faces,
@@ -517,14 +518,6 @@ pub fn sandwich_panels(
         .into_par_iter()
         .map(|e| ctx.bend(EdgeId(e)).map(|(bend, _, _)| bend))
         .collect();
-    let widened = |e: usize| {
-        let h = EdgeId(e as u32).half_edge();
-        [mesh.face(h), mesh.face(h.twin())]
-            .into_iter()
-            .flatten()
-            .any(|f| faces[f.index()].widened)
-    };
-    check_bends(mesh, &bends, options, t, widened)?;
     let layers: Vec<FaceLayers> = (0..faces.len())
         .into_par_iter()
         .map(|f| face_layers(mesh, FaceId(f as u32), &faces[f]))
@@ -547,7 +540,7 @@ pub fn sandwich_panels(
         .map(|b| b.strips(options.samples, t))
         .collect();
     let mut notes = vec![format!(
-        "two-layer sandwich: every edge panel cut twice, outer layer E and inner layer I (glued behind the E of the same number), {} mm apart; flaps lapped at the face corners, so the shell is two layers thick everywhere",
+        "two-layer sandwich: every edge panel cut twice, outer layer E and inner layer I (glued behind the E of the same number), {} mm apart; flaps lapped at the face corners, one panel's outer layer over the other's inner, so the laps are two layers thick like the rest",
         fmt_num(t)
     )];
     let finer = strips
@@ -579,48 +572,106 @@ pub fn sandwich_panels(
     Ok(Sandwich { panels, notes })
 }
 
-/// Refuses a convex bend whose curve turns tighter than the card is thick, naming the
-/// face scale and the size that round every bend enough.
-fn check_bends(
+/// The band corner each half-edge leaves from, by half-edge.
+fn corners_of(mesh: &Mesh) -> Vec<u32> {
+    let mut corner_of = vec![0u32; mesh.half_edge_count()];
+    for f in mesh.faces() {
+        for (k, h) in mesh.face_half_edges(f).enumerate() {
+            corner_of[h.index()] = k as u32;
+        }
+    }
+    corner_of
+}
+
+/// The convex bend that turns tightest, as its edge and radius, where that radius is
+/// below 2T: the inner card's inside face lies 2T under the surface, and a curve
+/// offset past its radius folds back on itself.
+pub fn tightest_bend(
     mesh: &Mesh,
-    bends: &[Option<Bend>],
+    faces: &[FaceFlaps],
     options: &EdgeOptions,
     t: f64,
-    widened: impl Fn(usize) -> bool,
-) -> Result<(), SchemeError> {
-    let tightest = bends
-        .iter()
-        .enumerate()
-        .filter_map(|(e, b)| {
-            b.filter(|b| b.turning() > 0.0)
-                .map(|b| (e, b.tightest_radius()))
+) -> Option<(usize, f64)> {
+    let corner_of = corners_of(mesh);
+    let ctx = Context {
+        mesh,
+        faces,
+        corner_of: &corner_of,
+        options,
+        t,
+    };
+    (0..mesh.edge_count())
+        .filter_map(|e| {
+            let (bend, _, _) = ctx.bend(EdgeId(e as u32))?;
+            (bend.turning() > 0.0).then(|| (e, bend.tightest_radius()))
         })
-        .min_by(|x, y| x.1.total_cmp(&y.1));
-    let Some((edge, radius)) = tightest.filter(|&(_, r)| r < t) else {
-        return Ok(());
+        .min_by(|x, y| x.1.total_cmp(&y.1))
+        .filter(|&(_, r)| r < 2.0 * t)
+}
+
+/// Rebuilds at most this many times to find a size or face scale round enough.
+const FIX_TRIES: usize = 8;
+
+/// The refusal of bend `edge` of `radius` mm: names the face scale and the size with
+/// which `tightest` (the scheme rebuilt) finds every bend round enough, each tried
+/// from the radii found (a bend's radius grows with the model's size and with
+/// (1 − face scale), but a band widened to hold holes moves too).
+fn too_tight(
+    mesh: &Mesh,
+    options: &EdgeOptions,
+    t: f64,
+    (edge, radius): (usize, f64),
+    tightest: impl Fn(&Mesh, &EdgeOptions) -> Option<(usize, f64)>,
+) -> SchemeError {
+    let need = 2.0 * t;
+    let mut factor = 1.0;
+    let mut r = radius;
+    let mut size = None;
+    for _ in 0..FIX_TRIES {
+        factor *= need / r.max(1e-9) * 1.001;
+        let mut scaled = mesh.clone();
+        scaled.scale(factor);
+        match tightest(&scaled, options) {
+            None => {
+                size = Some((mesh.longest_side() * factor / options.panel.scale).ceil());
+                break;
+            }
+            Some((_, tighter)) => r = tighter,
+        }
+    }
+    let mut face_scale = None;
+    let (mut s, mut r) = (options.panel.face_scale, radius);
+    for _ in 0..FIX_TRIES {
+        s = ((1.0 - (1.0 - s) * need / r.max(1e-9) * 1.001) * 100.0).floor() / 100.0;
+        if s < 0.05 {
+            break;
+        }
+        let mut tried = options.clone();
+        tried.panel.face_scale = s;
+        match tightest(mesh, &tried) {
+            None => {
+                face_scale = Some(s);
+                break;
+            }
+            Some((_, tighter)) => r = tighter,
+        }
+    }
+    let fixes = match (face_scale, size) {
+        (Some(s), Some(size)) => format!(
+            "; --face-scale {} or --size {size}mm rounds every bend enough",
+            fmt_num(s)
+        ),
+        (Some(s), None) => format!("; --face-scale {} rounds every bend enough", fmt_num(s)),
+        (None, Some(size)) => format!("; --size {size}mm rounds every bend enough"),
+        (None, None) => "; a simpler model (--target-edges) or thinner card may build".to_string(),
     };
-    // Every bend's radius grows with the model's size and with the gap between band
-    // and edge, (1 − face scale); a band widened to hold holes does not follow
-    // --face-scale, so only the size is named for it (larger, more holes fit and fewer
-    // bands widen, so the size named is if anything more than enough).
-    let factor = t / radius.max(1e-9) * 1.001;
-    let size = (mesh.longest_side() * factor).ceil();
-    let face_scale = 1.0 - (1.0 - options.panel.face_scale) * factor;
-    let fixes = if face_scale >= 0.05 && !widened(edge) {
-        format!(
-            "--face-scale {} or --size {size}mm",
-            fmt_num((face_scale * 100.0).floor() / 100.0)
-        )
-    } else {
-        format!("--size {size}mm")
-    };
-    Err(SchemeError::Options(format!(
-        "--thickness {}mm: the bend of {} turns tighter (radius {} mm) than the card is thick, so its inner layer would fold back on itself; {fixes} rounds every bend to at least {} mm",
+    SchemeError::Options(format!(
+        "--thickness {}mm: the bend of {} turns tighter (radius {} mm) than the two layers are thick ({} mm), so the inner layer would fold back on itself{fixes}",
         fmt_num(t),
         Name::new(&OUTER, edge as u32),
         fmt_num((radius * 1000.0).round() / 1000.0),
-        fmt_num(t)
-    )))
+        fmt_num(need)
+    ))
 }
 
 /// Partner ids name the panels as the builder finds them: by their outer layer.

@@ -276,6 +276,7 @@ mod tests {
                     hole_margin: 0.5,
                     label_height: 2.0,
                     panel_limit: None,
+                    scale: 1.0,
                 },
                 bridge_scale: 0.5,
                 flap_scale: 0.5,
