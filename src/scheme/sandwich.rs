@@ -12,9 +12,9 @@
 //!   that the flat strips, chords of the curves, keep the layers T apart and their
 //!   widths T·θ apart within hundredths of a millimetre.
 //! - At a face corner the flaps of two panels overlap. In the outer layer the flap of
-//!   the face's earlier band edge keeps the overlap and the later one gives it up; in
-//!   the inner layer the reverse (where three overlap, the earliest keeps the outer and
-//!   the latest the inner). So every covered point of a face has one outer and one
+//!   the face's earlier band edge (a boundary edge's before any other) keeps the
+//!   overlap and the later one gives it up; in the inner layer the reverse (where three
+//!   overlap, the earliest keeps the outer and the latest the inner). So every covered point of a face has one outer and one
 //!   inner layer over it: the shell is 2T thick everywhere, each pin goes through both
 //!   layers, and the seams of the two layers are staggered, a lap joint.
 //! - A convex bend whose curve turns tighter than 2T (the inner card's inside face) would
@@ -186,8 +186,9 @@ struct FaceLayers {
 /// left hanging on no fold.
 const LAP_ROUNDS: usize = 8;
 
-/// Shares face `f`'s flaps out to the layers: in the outer layer flap k gives up what
-/// the flaps before it cover, in the inner layer what the flaps after it cover. A piece
+/// Shares face `f`'s flaps out to the layers: in the outer layer a flap gives up what
+/// the flaps before it cover, in the inner layer what the flaps after it cover (in band
+/// edge order, boundary edges first). A piece
 /// so cut off its fold is left out, and then from the other layer too, so the two
 /// layers still cover the same ground.
 fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
@@ -203,21 +204,34 @@ fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
                 .collect()
         })
         .collect();
+    // A boundary edge's panel is its flap alone, with nothing else to hold it: its flap
+    // comes first, keeping the outer layer of every overlap (and the pins there).
+    let boundary: Vec<bool> = mesh
+        .face_half_edges(f)
+        .map(|h| mesh.face(h.twin()).is_none())
+        .collect();
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by_key(|&k| (!boundary[k], k));
     let mut gone: Vec<Vec<DVec2>> = Vec::new();
     let mut kept = Vec::new();
     for _ in 0..LAP_ROUNDS {
         let mut cut_off = Vec::new();
         kept = (0..n)
             .map(|k| {
-                let mut layer = |others: std::ops::Range<usize>| {
+                let mut layer = |others: &[usize]| {
                     let clips = others
-                        .map(|j| &flat[j][..])
+                        .iter()
+                        .map(|&j| &flat[j][..])
                         .chain(gone.iter().map(|g| &g[..]));
                     let (piece, off) = lap(&flat[k], clips);
                     cut_off.extend(off);
                     piece
                 };
-                [layer(0..k), layer(k + 1..n)]
+                let at = order
+                    .iter()
+                    .position(|&j| j == k)
+                    .expect("every flap is ranked");
+                [layer(&order[..at]), layer(&order[at + 1..])]
             })
             .collect::<Vec<_>>();
         if cut_off.is_empty() {
