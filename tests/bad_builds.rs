@@ -713,6 +713,10 @@ const ABSURD_OPTIONS: &[OptionCase] = &[
         &["--face-scale: 2 must be greater than 0 and at most 1"],
     ),
     (
+        &["--scheme", "quad-edge", "--face-scale", "1"],
+        &["--face-scale: the edge schemes' bends run between the face bands and the edges, so a band must be smaller than its face: below 1, not 1"],
+    ),
+    (
         &["--samples", "8"],
         &["--samples: the half-edge scheme does not take this option; it is an option of quad-edge, winged-edge, chosen with --scheme"],
     ),

@@ -83,6 +83,14 @@ pub struct BandArgs {
 impl BandArgs {
     /// Checks the values and fills in the defaults.
     pub fn resolve(&self, panel: PanelOptions) -> Result<EdgeOptions, String> {
+        if panel.face_scale >= 1.0 {
+            // The bend runs from the band to the edge and back: a band as large as
+            // the face leaves it no width.
+            return Err(format!(
+                "--face-scale: the edge schemes' bends run between the face bands and the edges, so a band must be smaller than its face: below 1, not {} (default 0.5)",
+                panel.face_scale
+            ));
+        }
         let samples = self.samples.unwrap_or(SAMPLES);
         if !(1..=64).contains(&samples) {
             return Err(format!("--samples: {samples} must be between 1 and 64"));
