@@ -919,7 +919,7 @@ fn check_holes(
 }
 
 /// The report's figures on connections with fewer holes than wanted: the scheme's note
-/// "X of Y connections hold fewer fastener holes than asked (--holes N)" and the
+/// "X of Y connections hold fewer fastener holes than asked (--holes N in each …)" and the
 /// fasteners warning on the Z with none ("Z of Y connections hold no …", or "no … fits
 /// at Z of Y connections" when most have none), as (X + Z, Y, Z) if either is there.
 /// The note's N must be `wanted`.

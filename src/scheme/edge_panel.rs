@@ -695,7 +695,7 @@ pub fn edge_scheme_notes(
     }
     if reduced > 0 {
         notes.push(format!(
-            "{reduced} of {connections} connections hold fewer fastener holes than asked (--holes {}) but at least one: their flap overlaps cannot hold more {} mm holes with {} mm of material around each; a larger --size, a smaller --hole-diameter or --hole-margin, or fewer panels (--target-edges) helps",
+            "{reduced} of {connections} connections hold fewer fastener holes than asked (--holes {} in each of a corner's flap overlaps) but at least one: their flap overlaps cannot hold more {} mm holes with {} mm of material around each; a larger --size, a smaller --hole-diameter or --hole-margin, or fewer panels (--target-edges) helps",
             panel.holes,
             crate::units::fmt_num(panel.hole_diameter),
             crate::units::fmt_num(panel.hole_margin)
