@@ -113,7 +113,7 @@ fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
             assert!(id.starts_with('B'), "{id}: a part inside is a bracket");
             assert_eq!(panel.id().number, edge, "{id}: its id names its edge");
             assert_eq!(loops.len(), 1, "{id}: a bracket has no inner cut");
-            let normal = vector_area(&outer).normalize();
+            let normal = polygon_vector_area(&outer).normalize();
             rebuilt_brackets.push(BracketPart {
                 edge: panel.id().number,
                 id,
@@ -128,7 +128,7 @@ fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
         };
         let normal = p.mesh.face_normal(FaceId(face));
         assert!(
-            vector_area(&outer).dot(normal) > 0.0,
+            polygon_vector_area(&outer).dot(normal) > 0.0,
             "{}: its outer face looks inward",
             panel.id()
         );
@@ -162,14 +162,6 @@ fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
         slots: rebuilt_slots,
         brackets: rebuilt_brackets,
     }
-}
-
-fn vector_area(points: &[DVec3]) -> DVec3 {
-    let n = points.len();
-    (0..n)
-        .map(|k| points[k].cross(points[(k + 1) % n]))
-        .sum::<DVec3>()
-        * 0.5
 }
 
 fn is_convex(part: &Part) -> bool {

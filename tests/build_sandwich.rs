@@ -78,32 +78,21 @@ fn bend_width(mesh: &Mesh, layer: &Layer, depth: f64) -> f64 {
     max - min
 }
 
-/// The distance from `p` to a planar polygon in 3D.
+/// The distance from `p` to a planar polygon in 3D: its height over the plane, and
+/// in the plane its distance to the polygon (none inside).
 fn point_polygon(p: DVec3, poly: &[DVec3]) -> f64 {
-    let normal = vector_area(poly).normalize();
-    let on_plane = p - (p - poly[0]).dot(normal) * normal;
+    let normal = polygon_vector_area(poly).normalize();
     let ex = (poly[1] - poly[0]).normalize();
     let ey = normal.cross(ex);
     let to2 = |q: DVec3| DVec2::new((q - poly[0]).dot(ex), (q - poly[0]).dot(ey));
     let flat: Vec<DVec2> = poly.iter().map(|&q| to2(q)).collect();
-    if inside(&flat, to2(on_plane)) {
-        return (p - on_plane).length();
-    }
-    (0..poly.len())
-        .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-            let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
-            p.distance(a + t * (b - a))
-        })
-        .fold(f64::MAX, f64::min)
-}
-
-fn vector_area(points: &[DVec3]) -> DVec3 {
-    let n = points.len();
-    (0..n)
-        .map(|i| points[i].cross(points[(i + 1) % n]))
-        .sum::<DVec3>()
-        / 2.0
+    let height = (p - poly[0]).dot(normal);
+    let across = if inside(&flat, to2(p)) {
+        0.0
+    } else {
+        distance_to_border(&flat, to2(p))
+    };
+    height.hypot(across)
 }
 
 /// Builds both layers of every panel and checks the sandwich; returns the number of
@@ -264,7 +253,7 @@ fn flaps_in(mesh: &Mesh, f: FaceId, layers: &[Layer], depth: f64) -> Vec<Vec<DVe
         .iter()
         .flat_map(|l| &l.facets)
         .filter(|poly| {
-            let normal = vector_area(poly).normalize();
+            let normal = polygon_vector_area(poly).normalize();
             normal.dot(n) > 1.0 - 1e-9 && poly.iter().all(|&q| (q - c).dot(n).abs() < 1e-6)
         })
         .map(|poly| {
@@ -334,7 +323,7 @@ fn check_pins(name: &str, outer: &[Layer], inner: &[Layer], t: f64) {
                     (
                         h.position,
                         h.connection,
-                        vector_area(facet).normalize(),
+                        polygon_vector_area(facet).normalize(),
                         l.edge,
                     )
                 })

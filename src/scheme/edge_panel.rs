@@ -712,15 +712,22 @@ pub fn edge_scheme_notes(
 
 /// Builds every edge panel from the faces' flaps. Returns the panels (in edge order).
 pub fn edge_panels(mesh: &Mesh, faces: &[FaceFlaps], options: &EdgeOptions) -> Panels {
+    let corner_of = corners_of(mesh);
+    Panels::build(mesh.edge_count(), |e| {
+        edge_panel(mesh, EdgeId(e as u32), faces, &corner_of, options)
+    })
+}
+
+/// The band corner each half-edge leaves from (its place in its face's loop), by
+/// half-edge.
+pub(super) fn corners_of(mesh: &Mesh) -> Vec<u32> {
     let mut corner_of = vec![0u32; mesh.half_edge_count()];
     for f in mesh.faces() {
         for (k, h) in mesh.face_half_edges(f).enumerate() {
             corner_of[h.index()] = k as u32;
         }
     }
-    Panels::build(mesh.edge_count(), |e| {
-        edge_panel(mesh, EdgeId(e as u32), faces, &corner_of, options)
-    })
+    corner_of
 }
 
 /// Quadratic Bézier point.
@@ -814,7 +821,9 @@ fn edge_panel(
     });
 
     let mut labels = Vec::with_capacity(1 + FLAP_LABELS * (1 + usize::from(n > 0)));
-    labels.push(id_label(e, &vertices, &facets, n, options));
+    // On the bend's middle strip (the flap is facet 0; a boundary panel has only it).
+    let (id, height) = (panel_id(e), options.panel.label_height);
+    labels.push(bend_id_label(id, &vertices, &facets, 1 + n / 2, n, height));
     flap_labels(mesh, part, f, h, k, 0, options, &mut labels);
     if let Some((g, other, k2, facet)) = flap_g {
         flap_labels(mesh, other, g, h.twin(), k2, facet, options, &mut labels);
@@ -857,25 +866,26 @@ fn push_rails(
     }
 }
 
-/// Edge `e`'s panel id: on the middle strip of its `n`-strip bend, along the edge (on
-/// the flap for a boundary edge).
-fn id_label(
-    e: EdgeId,
+/// A bend panel's id: on facet `facet` (clamped to the facets there are), along the
+/// ruling in the middle of its `n`-strip bend (rails 2i at v, 2i + 1 at v′; the flap's
+/// band edge for a boundary edge, `n` 0).
+pub(super) fn bend_id_label(
+    text: Name,
     vertices: &[DVec3],
     facets: &Loops,
+    facet: usize,
     n: usize,
-    options: &EdgeOptions,
+    height: f64,
 ) -> Label {
     let (a, b) = (vertices[2 * (n / 2)], vertices[2 * (n / 2) + 1]);
-    let id_facet = if n > 0 { 1 + n / 2 } else { 0 };
-    let id_facet = id_facet.min(facets.len() - 1);
-    let corners = &facets[id_facet];
+    let facet = facet.min(facets.len() - 1);
+    let corners = &facets[facet];
     Label {
-        text: panel_id(e),
+        text,
         anchor: corners.iter().map(|&i| vertices[i as usize]).sum::<DVec3>() / corners.len() as f64,
         direction: (b - a).normalize(),
-        height: options.panel.label_height,
-        facet: id_facet as u32,
+        height,
+        facet: facet as u32,
         kind: LabelKind::Panel,
         on_edge: false,
         slide: 0.3 * a.distance(b),

@@ -29,10 +29,12 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 use rayon::prelude::*;
 
-use super::edge_panel::{bezier, flap_labels, EdgeOptions, FaceFlaps, FaceFrame};
+use super::edge_panel::{
+    bend_id_label, bezier, corners_of, flap_labels, EdgeOptions, FaceFlaps, FaceFrame,
+};
 use super::SchemeError;
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use crate::panel::{Covers, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, Panels, Source};
+use crate::panel::{Covers, Hole, IdKind, Label, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, signed_area};
 use crate::units::fmt_num;
 
@@ -520,14 +522,7 @@ pub fn sandwich_panels(
     if let Some(bend) = tightest_bend(mesh, faces, options, t) {
         return Err(too_tight(mesh, options, t, bend, tightest));
     }
-    let corner_of = corners_of(mesh);
-    let ctx = Context {
-        mesh,
-        faces,
-        corner_of: &corner_of,
-        options,
-        t,
-    };
+    let ctx = Context::new(mesh, faces, options, t);
     let bends: Vec<Option<Bend>> = (0..mesh.edge_count() as u32)
         .into_par_iter()
         .map(|e| ctx.bend(EdgeId(e)).map(|(bend, _, _)| bend))
@@ -586,17 +581,6 @@ pub fn sandwich_panels(
     Ok(Sandwich { panels, notes })
 }
 
-/// The band corner each half-edge leaves from, by half-edge.
-fn corners_of(mesh: &Mesh) -> Vec<u32> {
-    let mut corner_of = vec![0u32; mesh.half_edge_count()];
-    for f in mesh.faces() {
-        for (k, h) in mesh.face_half_edges(f).enumerate() {
-            corner_of[h.index()] = k as u32;
-        }
-    }
-    corner_of
-}
-
 /// The convex bend that turns tightest, as its edge and radius, where that radius is
 /// below 2T: the inner card's inside face lies 2T under the surface, and a curve
 /// offset past its radius folds back on itself.
@@ -606,14 +590,7 @@ pub fn tightest_bend(
     options: &EdgeOptions,
     t: f64,
 ) -> Option<(usize, f64)> {
-    let corner_of = corners_of(mesh);
-    let ctx = Context {
-        mesh,
-        faces,
-        corner_of: &corner_of,
-        options,
-        t,
-    };
+    let ctx = Context::new(mesh, faces, options, t);
     (0..mesh.edge_count())
         .filter_map(|e| {
             let (bend, _, _) = ctx.bend(EdgeId(e as u32))?;
@@ -721,12 +698,22 @@ fn strip_loops(n: usize, inserted_f: &[u32], inserted_g: &[u32]) -> Vec<Vec<u32>
 struct Context<'a> {
     mesh: &'a Mesh,
     faces: &'a [FaceFlaps],
-    corner_of: &'a [u32],
+    corner_of: Vec<u32>,
     options: &'a EdgeOptions,
     t: f64,
 }
 
-impl Context<'_> {
+impl<'a> Context<'a> {
+    fn new(mesh: &'a Mesh, faces: &'a [FaceFlaps], options: &'a EdgeOptions, t: f64) -> Self {
+        Context {
+            mesh,
+            faces,
+            corner_of: corners_of(mesh),
+            options,
+            t,
+        }
+    }
+
     /// Edge `e`'s half-edge with a face, that face and its band corner.
     fn side(&self, e: EdgeId) -> (HalfedgeId, FaceId, usize) {
         let h = if self.mesh.is_boundary_half_edge(e.half_edge()) {
@@ -833,7 +820,9 @@ impl Context<'_> {
         }
         let strip_facets: Vec<u32> = (first_strip..far_facet).collect();
         outer_partners(&mut labels);
-        labels.insert(0, self.id_label(id, &vertices, &facets, &strip_facets, n));
+        let facet = strip_facets.get(n / 2).copied().unwrap_or(0) as usize;
+        let height = self.options.panel.label_height;
+        labels.insert(0, bend_id_label(id, &vertices, &facets, facet, n, height));
         let covers = if inner {
             Covers::Inside(e.0)
         } else {
@@ -916,32 +905,6 @@ impl Context<'_> {
             .map(|(x, _)| x)
             .collect();
         (lp, inserted)
-    }
-
-    /// The layer's id on the middle strip of its bend, along the edge (on the flap for
-    /// a boundary edge).
-    fn id_label(
-        &self,
-        id: Name,
-        vertices: &[DVec3],
-        facets: &Loops,
-        strips: &[u32],
-        n: usize,
-    ) -> Label {
-        let (a, b) = (vertices[2 * (n / 2)], vertices[2 * (n / 2) + 1]);
-        let facet = strips.get(n / 2).copied().unwrap_or(0) as usize;
-        let corners = &facets[facet.min(facets.len() - 1)];
-        Label {
-            text: id,
-            anchor: corners.iter().map(|&i| vertices[i as usize]).sum::<DVec3>()
-                / corners.len() as f64,
-            direction: (b - a).normalize(),
-            height: self.options.panel.label_height,
-            facet: facet as u32,
-            kind: LabelKind::Panel,
-            on_edge: false,
-            slide: 0.3 * a.distance(b),
-        }
     }
 }
 

@@ -309,6 +309,16 @@ pub fn inside(poly: &[DVec2], p: DVec2) -> bool {
     inside
 }
 
+/// A 3D polygon's vector area: its length is the area, its direction the normal
+/// (right-hand rule).
+pub fn polygon_vector_area(points: &[DVec3]) -> DVec3 {
+    let n = points.len();
+    (0..n)
+        .map(|k| points[k].cross(points[(k + 1) % n]))
+        .sum::<DVec3>()
+        * 0.5
+}
+
 pub fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
     (0..poly.len())
         .map(|i| {
