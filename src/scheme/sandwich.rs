@@ -308,8 +308,9 @@ fn lap<'a>(
         &grown,
         OverlayRule::Intersect,
     );
-    let (piece, more) = fold_piece(&opened, start, end, tolerance, span);
-    off.extend(more);
+    // Everything of the piece outside what stays is cut off, the opened pieces that
+    // hang on nothing included (once: the cut-off area is reported).
+    let (piece, _) = fold_piece(&opened, start, end, tolerance, span);
     if let Some((kept, _)) = &piece {
         let rest = overlay(&[outline], &[as_arrays(kept)], OverlayRule::Difference);
         off.extend(
@@ -1007,5 +1008,29 @@ mod tests {
         assert_eq!(outline[0], DVec2::new(8.0, 0.0));
         assert_eq!(outline[1], DVec2::new(40.0, 0.0));
         assert!((signed_area(&outline) - 320.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_neck_narrower_than_a_millimetre_is_cut_through() {
+        // A 40 × 10 flap less a block over x 10..30 above y 0.4: two squares joined
+        // along the fold by a strip 0.4 mm deep.
+        let flap =
+            [(0.0, 0.0), (40.0, 0.0), (40.0, 10.0), (0.0, 10.0)].map(|(x, y)| DVec2::new(x, y));
+        let block =
+            [(10.0, 0.4), (30.0, 0.4), (30.0, 20.0), (10.0, 20.0)].map(|(x, y)| DVec2::new(x, y));
+        let (kept, off) = lap(&flap, [&block[..]].into_iter());
+        let (outline, fold) = kept.expect("a piece on the fold");
+        // One square stays (its corners rounded by the opening's disc), the other
+        // square and the strip are cut off.
+        let area = signed_area(&outline);
+        assert!(area > 99.0 && area < 100.0 + 1e-6, "{area}");
+        let run = fold[1] - fold[0];
+        let at_an_end = fold[0] < 0.02 || fold[1] > 0.98;
+        assert!(at_an_end && run > 0.22 && run <= 0.25 + 1e-9, "{fold:?}");
+        let cut: f64 = off.iter().map(|p| signed_area(p).abs()).sum();
+        assert!(
+            (cut + area - (100.0 + 100.0 + 20.0 * 0.4)).abs() < 0.5,
+            "{cut}"
+        );
     }
 }
