@@ -1,4 +1,4 @@
-//! Rigid panels (`--thickness` with the half-edge scheme): the parts are rebuilt in 3D
+//! Rigid panels (`--thickness` with the half-edge and net schemes): the parts are rebuilt in 3D
 //! from what is cut (each flat outline mapped back onto its face plane by its unrolling
 //! and moved inward by the thickness) and checked with this file's own geometry: no two
 //! parts pass into each other, none sticks out of the model, and the outer surface left
@@ -24,7 +24,8 @@ const OVERLAP: f64 = 0.01;
 
 /// A part rebuilt in 3D: its outer polygon on its face plane and the same moved inward.
 struct Part {
-    face: u32,
+    /// Its id on the sheet.
+    id: String,
     outer: Vec<DVec3>,
     normal: DVec3,
 }
@@ -43,9 +44,9 @@ impl Part {
     }
 }
 
-/// The job of `unfold MODEL --size SIZE --thickness 3mm`.
-fn rigid_job(model: &Path, size: &str, out: &Path) -> unfold::config::Job {
-    let mut o = options("half-edge", size, 0, out);
+/// The job of `unfold MODEL --scheme SCHEME --size SIZE --thickness 3mm`.
+fn rigid_job(scheme: &str, model: &Path, size: &str, out: &Path) -> unfold::config::Job {
+    let mut o = options(scheme, size, 0, out);
     o.scheme_values.set("thickness", &format!("{T}mm"));
     resolve(o, model)
 }
@@ -72,18 +73,30 @@ impl BracketPart {
 struct Rebuilt {
     mesh: Mesh,
     parts: Vec<Part>,
+    /// Each face's part.
+    part_of: Vec<usize>,
     slots: Vec<Vec<Vec<DVec3>>>,
     brackets: Vec<BracketPart>,
 }
 
+impl Rebuilt {
+    /// The part of face `f`.
+    fn part(&self, f: FaceId) -> &Part {
+        &self.parts[self.part_of[f.0 as usize]]
+    }
+}
+
 /// The parts of a rigid build, rebuilt from the flat panels, and the mesh they cover.
-fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
-    let job = rigid_job(model, size, out);
+/// A half-edge part covers one face; a net part a flat region of faces, whose corners
+/// all lie within 0.01 mm of its plane.
+fn rebuilt_parts(scheme: &str, model: &Path, size: &str, out: &Path) -> Rebuilt {
+    let job = rigid_job(scheme, model, size, out);
     let p = pipeline(&job);
     let frames = frames_of(&p.panels);
     let mut rebuilt_parts = Vec::new();
     let mut rebuilt_slots = Vec::new();
     let mut rebuilt_brackets = Vec::new();
+    let mut part_of = vec![usize::MAX; p.mesh.face_count()];
     for ((panel, flat), frames) in p.panels.iter().zip(&p.flat).zip(&frames) {
         // All facets of a rigid part lie in one plane: the first facet's frame maps
         // every point back.
@@ -123,45 +136,90 @@ fn rebuilt_parts(model: &Path, size: &str, out: &Path) -> Rebuilt {
             });
             continue;
         }
-        let Covers::Face(face) = panel.source.covers else {
-            panic!("{}: a rigid panel covers one face", panel.id());
+        let faces: Vec<u32> = match panel.source.covers {
+            Covers::Face(face) => vec![face],
+            Covers::Faces(k) => p.output.face_groups[k as usize].faces.clone(),
+            _ => panic!("{}: a rigid panel covers faces", panel.id()),
         };
-        let normal = p.mesh.face_normal(FaceId(face));
-        assert!(
-            polygon_vector_area(&outer).dot(normal) > 0.0,
-            "{}: its outer face looks inward",
-            panel.id()
-        );
-        let on_plane = loops
-            .iter()
-            .flatten()
-            .map(|&q| (q - p.mesh.face_centre(FaceId(face))).dot(normal).abs())
-            .fold(0.0, f64::max);
-        assert!(
-            on_plane < 1e-6,
-            "{}: {on_plane} mm off its face plane",
-            panel.id()
-        );
+        let normal = polygon_vector_area(&outer).normalize();
+        for &f in &faces {
+            let f = FaceId(f);
+            assert!(
+                normal.dot(p.mesh.face_normal(f)) > 1.0 - 1e-9,
+                "{}: its outer face looks away from F{}",
+                panel.id(),
+                f.0
+            );
+            // The part's plane holds its faces: its own corners and theirs.
+            let on_plane = loops
+                .iter()
+                .flatten()
+                .copied()
+                .chain(p.mesh.face_positions(f))
+                .map(|q| (q - p.mesh.face_centre(f)).dot(normal).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                on_plane < OVERLAP,
+                "{}: {on_plane} mm off the plane of F{}",
+                panel.id(),
+                f.0
+            );
+            assert_eq!(part_of[f.0 as usize], usize::MAX, "F{} in two parts", f.0);
+            part_of[f.0 as usize] = rebuilt_parts.len();
+        }
         let part = Part {
-            face,
+            id: panel.id().to_string(),
             outer,
             normal,
         };
-        assert!(
-            is_convex(&part),
-            "{}: the faces are convex, so is each part",
-            panel.id()
-        );
+        if faces.len() == 1 {
+            assert!(
+                is_convex(&part),
+                "{}: the faces are convex, so is each part of one",
+                panel.id()
+            );
+        }
         rebuilt_parts.push(part);
         rebuilt_slots.push(loops[1..].to_vec());
     }
-    assert_eq!(rebuilt_parts.len(), p.mesh.face_count());
+    assert!(
+        part_of.iter().all(|&k| k != usize::MAX),
+        "every face in a part"
+    );
     Rebuilt {
         mesh: p.mesh,
         parts: rebuilt_parts,
+        part_of,
         slots: rebuilt_slots,
         brackets: rebuilt_brackets,
     }
+}
+
+/// A part as convex parts: itself, or its triangles (the crate's ear clipping).
+fn convex_pieces(part: &Part) -> Vec<Part> {
+    if is_convex(part) {
+        return vec![Part {
+            id: part.id.clone(),
+            outer: part.outer.clone(),
+            normal: part.normal,
+        }];
+    }
+    unfold::mesh::split::triangulate(&part.outer)
+        .into_iter()
+        .map(|t| Part {
+            id: part.id.clone(),
+            outer: t.map(|k| part.outer[k]).to_vec(),
+            normal: part.normal,
+        })
+        .collect()
+}
+
+/// How deep two parts pass into each other (mm): the deepest pair of their convex
+/// pieces.
+fn part_penetration(a: &[Part], b: &[Part]) -> f64 {
+    a.iter()
+        .flat_map(|p| b.iter().map(move |q| penetration(p, q)))
+        .fold(0.0, f64::max)
 }
 
 fn is_convex(part: &Part) -> bool {
@@ -236,10 +294,10 @@ fn outside_by(poly: &[DVec2], p: DVec2) -> f64 {
     }
 }
 
-/// Checks the parts of a rigid build of `model` at `size`; returns how many edges have
-/// a groove (obtuse), are acute, and are concave.
-fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
-    let rebuilt = rebuilt_parts(model, size, &tmp.join("job"));
+/// Checks the parts of a rigid build of `model` at `size` by `scheme`; returns how many
+/// edges have a groove (obtuse), are acute, and are concave (or flat).
+fn check_rigid(scheme: &str, model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
+    let rebuilt = rebuilt_parts(scheme, model, size, &tmp.join("job"));
     let (mesh, parts) = (&rebuilt.mesh, &rebuilt.parts);
     let name = model.file_stem().unwrap().to_string_lossy().into_owned();
     check_brackets(&name, &rebuilt);
@@ -247,22 +305,23 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
     // No two parts pass into each other, near or far in the mesh.
     let mut deepest = (0.0, 0, 0);
     let boxes: Vec<(DVec3, DVec3)> = parts.iter().map(|p| corners_box(&p.corners())).collect();
+    let pieces: Vec<Vec<Part>> = parts.iter().map(convex_pieces).collect();
     for i in 0..parts.len() {
         for j in i + 1..parts.len() {
             if !boxes_meet(&boxes[i], &boxes[j]) {
                 continue;
             }
-            let d = penetration(&parts[i], &parts[j]);
+            let d = part_penetration(&pieces[i], &pieces[j]);
             if d > deepest.0 {
-                deepest = (d, parts[i].face, parts[j].face);
+                deepest = (d, i, j);
             }
         }
     }
     assert!(
         deepest.0 <= OVERLAP,
-        "{name}: the parts of F{} and F{} pass {} mm into each other",
-        deepest.1,
-        deepest.2,
+        "{name}: the parts {} and {} pass {} mm into each other",
+        parts[deepest.1].id,
+        parts[deepest.2].id,
         deepest.0
     );
 
@@ -270,10 +329,9 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
     // the panels' inner corners, and every corner of every bracket.
     let triangles = triangles(mesh);
     let panel_corners = parts.iter().flat_map(|part| {
-        let face = format!("F{}", part.face);
         part.outer
             .iter()
-            .map(move |&p| (face.clone(), p - T * part.normal))
+            .map(move |&p| (part.id.clone(), p - T * part.normal))
     });
     let bracket_corners = rebuilt
         .brackets
@@ -303,10 +361,19 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
         let turn = na.cross(nb).dot((b - a).normalize()).atan2(na.dot(nb));
         let delta = PI - turn;
         let middle = 0.5 * (a + b);
-        let open: f64 = [fa, fb]
+        let sides = [
+            rebuilt.part_of[fa.0 as usize],
+            rebuilt.part_of[fb.0 as usize],
+        ];
+        if sides[0] == sides[1] {
+            // Inside one part (a flat region): no seam, nothing open.
+            kinds[2] += 1;
+            continue;
+        }
+        let open: f64 = sides
             .iter()
-            .map(|&f| {
-                let part = &parts[f.0 as usize];
+            .map(|&k| {
+                let part = &parts[k];
                 let x = (part.outer[1] - part.outer[0]).normalize();
                 let y = part.normal.cross(x);
                 let flat =
@@ -335,7 +402,7 @@ fn check_rigid(model: &Path, size: &str, tmp: &Path) -> [usize; 3] {
     // assembled model holds one closed solid per part.
     let out = tmp.join("out");
     let m = build(
-        "half-edge",
+        scheme,
         model,
         size,
         &out,
@@ -395,18 +462,34 @@ fn the_platonic_solids_in_3mm_sheet_fit_without_overlap() {
     let tmp = TempDir::new().unwrap();
     // Tetrahedron: acute edges only; cube: right angles; icosahedron: five faces at
     // each corner, whose corners must be cut back.
-    let tetra = check_rigid(&model("tetrahedron"), "200mm", &tmp.path().join("tetra"));
+    let tetra = check_rigid(
+        "half-edge",
+        &model("tetrahedron"),
+        "200mm",
+        &tmp.path().join("tetra"),
+    );
     assert_eq!(tetra, [0, 6, 0]);
-    let cube = check_rigid(&model("hexahedron"), "200mm", &tmp.path().join("cube"));
+    let cube = check_rigid(
+        "half-edge",
+        &model("hexahedron"),
+        "200mm",
+        &tmp.path().join("cube"),
+    );
     assert_eq!(cube, [12, 0, 0]);
-    let ico = check_rigid(&model("icosahedron"), "200mm", &tmp.path().join("ico"));
+    let ico = check_rigid(
+        "half-edge",
+        &model("icosahedron"),
+        "200mm",
+        &tmp.path().join("ico"),
+    );
     assert_eq!(ico, [30, 0, 0]);
 }
 
 #[test]
 fn a_torus_in_3mm_sheet_fits_without_overlap() {
     let tmp = TempDir::new().unwrap();
-    let [obtuse, acute, concave] = check_rigid(&model("torus-8x6"), "300mm", tmp.path());
+    let [obtuse, acute, concave] =
+        check_rigid("half-edge", &model("torus-8x6"), "300mm", tmp.path());
     assert_eq!(obtuse + acute + concave, 8 * 6 * 2);
     assert!(concave > 0 && obtuse > 0, "{obtuse} {acute} {concave}");
     assert_same_bytes_on_one_and_two_threads(
@@ -423,7 +506,70 @@ fn a_simplified_shared_model_in_3mm_sheet_fits_without_overlap() {
     let tmp = TempDir::new().unwrap();
     // About 300 faces: 450 edges of a closed triangle mesh.
     let simple = simplified_obj(&shared.join("spot.obj"), 450, true, tmp.path());
-    check_rigid(&simple, "500mm", &tmp.path().join("spot"));
+    check_rigid("half-edge", &simple, "500mm", &tmp.path().join("spot"));
+}
+
+#[test]
+fn the_net_in_3mm_sheet_makes_one_part_per_flat_region() {
+    let tmp = TempDir::new().unwrap();
+    let parts = |model: &Path, size: &str, dir: &str| {
+        let out = tmp.path().join(dir);
+        let kinds = check_rigid("net", model, size, &out);
+        let m: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("out/manifest.json")).unwrap())
+                .unwrap();
+        (kinds, count(&m, "net.islands"))
+    };
+    // The star prism's two caps are split into triangles for the net; rigid, each cap
+    // is one part again: twelve, as in the file.
+    let (kinds, islands) = parts(&model("concave"), "200mm", "concave");
+    // Caps at right angles (20 edges), five acute star points, five concave edges
+    // and the fourteen diagonals the split drew in the caps.
+    assert_eq!((kinds, islands), ([20, 5, 5 + 14], 12));
+    // No two faces of the icosahedron lie in one plane: a part per face.
+    let (kinds, islands) = parts(&model("icosahedron"), "200mm", "ico");
+    assert_eq!((kinds, islands), ([30, 0, 0], 20));
+    // The torus's top and bottom rings are flat: each ring of eight faces is one part
+    // that stops short of closing round the hole (a C of seven faces, not convex) and
+    // one more; the other 32 faces are parts of their own.
+    let (_, islands) = parts(&model("torus-8x6"), "300mm", "torus");
+    assert_eq!(islands, 32 + 2 * 2);
+    assert_same_bytes_on_one_and_two_threads(
+        &model("concave"),
+        &["--scheme", "net", "--size", "200mm", "--thickness", "3mm"],
+    );
+    let Some(shared) = shared_models("the rigid net of a triangulated cube") else {
+        return;
+    };
+    // A cube of twelve triangles: six square parts, its diagonals inside them.
+    let (kinds, islands) = parts(&shared.join("cube.obj"), "200mm", "cube");
+    assert_eq!((kinds, islands), ([12, 0, 6], 6));
+}
+
+#[test]
+fn the_rigid_net_refuses_what_only_folds_need_and_names_islands() {
+    let tmp = TempDir::new().unwrap();
+    let cube = model("hexahedron");
+    for (extra, says) in [
+        (
+            vec!["--thickness", "3mm", "--island-spread", "2"],
+            "--island-spread",
+        ),
+        (vec!["--connectors", "none"], "--connectors none"),
+        (
+            vec!["--thickness", "3mm", "--connectors", "tab"],
+            "--connectors tab",
+        ),
+        (vec!["--thickness", "25mm", "--size", "40mm"], "N"),
+    ] {
+        let out = tmp.path().join("out");
+        let mut args = vec![cube.to_str().unwrap(), "--scheme", "net", "--size", "200mm"];
+        args.extend(extra);
+        args.extend(["--build-anyway", "--out", out.to_str().unwrap()]);
+        let run = unfold(args);
+        assert_refusal(says, &run, 2, &[says]);
+        assert!(!out.exists());
+    }
 }
 
 #[test]
@@ -562,8 +708,8 @@ fn check_brackets(name: &str, r: &Rebuilt) {
             assert_eq!(
                 slot.len(),
                 4,
-                "{name}: F{}: a slot has four corners",
-                part.face
+                "{name}: {}: a slot has four corners",
+                part.id
             );
             let sides: Vec<f64> = (0..4)
                 .map(|k| slot[k].distance(slot[(k + 1) % 4]))
@@ -571,8 +717,8 @@ fn check_brackets(name: &str, r: &Rebuilt) {
             let narrow = sides.iter().copied().fold(f64::MAX, f64::min);
             assert!(
                 (narrow - (T + 0.1)).abs() < 1e-6,
-                "{name}: F{}: a slot {narrow} mm wide",
-                part.face
+                "{name}: {}: a slot {narrow} mm wide",
+                part.id
             );
             let diagonals = (slot[0].distance(slot[2]), slot[1].distance(slot[3]));
             assert!(
@@ -589,7 +735,7 @@ fn check_brackets(name: &str, r: &Rebuilt) {
             unfold::mesh::split::triangulate(&b.outer)
                 .into_iter()
                 .map(|t| Part {
-                    face: u32::MAX,
+                    id: b.id.clone(),
                     outer: t.map(|k| b.outer[k]).to_vec(),
                     normal: b.normal,
                 })
@@ -606,10 +752,10 @@ fn check_brackets(name: &str, r: &Rebuilt) {
         );
         for f in [fa, fb] {
             assert!(
-                b.labels.contains(&format!("F{}", f.0)),
-                "{name}: {} names F{}: {:?}",
+                b.labels.contains(&r.part(f).id),
+                "{name}: {} names {}: {:?}",
                 b.id,
-                f.0,
+                r.part(f).id,
                 b.labels
             );
         }
@@ -655,13 +801,13 @@ fn check_brackets(name: &str, r: &Rebuilt) {
         );
         // In each of its panels' material (less a hundredth either side), only its
         // tabs, and those in slots.
-        for (f, part) in [fa, fb].map(|f| (f, &r.parts[f.0 as usize])) {
+        for (f, part) in [fa, fb].map(|f| (f, r.part(f))) {
             let o = part.outer[0];
             let x = (part.outer[1] - o).normalize();
             let y = part.normal.cross(x);
             let flat = |p: DVec3| DVec2::new((p - o).dot(x), (p - o).dot(y));
             let outline: Vec<DVec2> = part.outer.iter().map(|&p| flat(p)).collect();
-            let slots: Vec<Vec<DVec2>> = r.slots[f.0 as usize]
+            let slots: Vec<Vec<DVec2>> = r.slots[r.part_of[f.0 as usize]]
                 .iter()
                 .map(|s| s.iter().map(|&p| flat(p)).collect())
                 .collect();
@@ -675,28 +821,27 @@ fn check_brackets(name: &str, r: &Rebuilt) {
                     let in_slot = slots.iter().any(|s| outside_by(s, q) < 1e-6);
                     assert!(
                         outside_by(&outline, q) > -1e-9 && (!inside(&outline, q) || in_slot),
-                        "{name}: {} passes into F{} at {p} outside its slots",
+                        "{name}: {} passes into {} at {p} outside its slots",
                         b.id,
-                        f.0
+                        part.id
                     );
                 }
             }
         }
         // Clear of every other panel and every other bracket (where their boxes meet).
         let near = |c: &[DVec3]| boxes_meet(&corners_box(&b.corners()), &corners_box(c));
-        for part in r.parts.iter().filter(|p| p.face != fa.0 && p.face != fb.0) {
+        let own = [r.part(fa).id.clone(), r.part(fb).id.clone()];
+        for part in r.parts.iter().filter(|p| !own.contains(&p.id)) {
             if !near(&part.corners()) {
                 continue;
             }
-            for piece in &pieces[k] {
-                let d = penetration(part, piece);
-                assert!(
-                    d <= OVERLAP,
-                    "{name}: {} passes {d} mm into F{}",
-                    b.id,
-                    part.face
-                );
-            }
+            let d = part_penetration(&convex_pieces(part), &pieces[k]);
+            assert!(
+                d <= OVERLAP,
+                "{name}: {} passes {d} mm into {}",
+                b.id,
+                part.id
+            );
         }
         for (j, other) in r.brackets.iter().enumerate().skip(k + 1) {
             if !near(&other.corners()) {

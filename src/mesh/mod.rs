@@ -6,6 +6,7 @@
 
 pub mod build;
 pub mod components;
+pub mod coplanar;
 pub mod decimate;
 pub mod distance;
 pub mod geometry;

@@ -5,7 +5,7 @@
 //! clearance; a collar of panel material stays around it, so the slot is an
 //! inner cut of the panel.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::rigid::{
     interior_angle, outline_prisms, overlap, Prism, RigidOutline, OVERLAP_TOLERANCE,
@@ -299,15 +299,16 @@ fn arm_plan(
     })
 }
 
-/// `point`, projected on the outline's plane, lies inside the (convex) outline.
+/// `point`, projected on the outline's plane, lies inside the outline or on its border.
 fn over_outline(outline: &RigidOutline, point: DVec3) -> bool {
     let normal =
         crate::mesh::geometry::vector_area(outline.points.iter().copied()).normalize_or_zero();
-    let m = outline.points.len();
-    (0..m).all(|i| {
-        let (a, b) = (outline.points[i], outline.points[(i + 1) % m]);
-        (b - a).cross(point - a).dot(normal) >= 0.0
-    })
+    let x = normal.any_orthonormal_vector();
+    let y = normal.cross(x);
+    let flat = |p: DVec3| DVec2::new(p.dot(x), p.dot(y));
+    let poly: Vec<DVec2> = outline.points.iter().map(|&p| flat(p)).collect();
+    let q = flat(point);
+    crate::plane::contains(&poly, q) || crate::plane::distance_to_border(&poly, q) < 1e-9
 }
 
 /// The slot's collar lies inside the panel's outline, its base on side `k`.
@@ -333,7 +334,14 @@ fn collar_fits(mesh: &Mesh, outline: &RigidOutline, k: usize, slot: &Slot) -> bo
     let side_depth = (from - origin).dot(inward);
     let far = [slot.x[0] - slot.margin, slot.x[1] + slot.margin]
         .map(|x| from + (x - x_from) * dir + (depth - side_depth) * inward);
-    far.iter().all(|&c| over_outline(outline, c))
+    // A region's outline need not be convex: no corner of it may reach into the
+    // collar either.
+    let (x_lo, x_hi) = (slot.x[0] - slot.margin, slot.x[1] + slot.margin);
+    let corner_inside = outline.points.iter().any(|&c| {
+        let (x, y) = ((c - origin).dot(dir), (c - origin).dot(inward));
+        x_lo < x && x < x_hi && side_depth + 1e-9 < y && y < depth
+    });
+    !corner_inside && far.iter().all(|&c| over_outline(outline, c))
 }
 
 /// The box around some prisms.
@@ -396,9 +404,15 @@ fn quads_meet(a: &[DVec3; 4], b: &[DVec3; 4]) -> bool {
     true
 }
 
-/// The panel of a bracket: its outline, its id and its two panels' ids on its arms,
-/// the angle between the arms engraved.
-pub fn bracket_panel(bracket: &Bracket, label_height: f64) -> Panel {
+/// The panel of a bracket: its outline, its id (naming `edge`, the edge's number in the
+/// user's model) and its two panels' ids on its arms (`panel_id` of their faces), the
+/// angle between the arms engraved.
+pub fn bracket_panel(
+    bracket: &Bracket,
+    label_height: f64,
+    edge: u32,
+    panel_id: &dyn Fn(FaceId) -> Name,
+) -> Panel {
     let label =
         |text: Name, (anchor, direction): (DVec3, DVec3), kind: LabelKind, arm: usize| Label {
             text,
@@ -412,14 +426,14 @@ pub fn bracket_panel(bracket: &Bracket, label_height: f64) -> Panel {
         };
     let tenths = (bracket.angle.to_degrees() * 10.0).round() as u32;
     let mut labels = vec![label(
-        Name::with_part(&BRACKET, bracket.edge.0, bracket.part),
+        Name::with_part(&BRACKET, edge, bracket.part),
         bracket.id_at,
         LabelKind::Panel,
         0,
     )];
     for (arm, (face, anchor, direction)) in bracket.arm_labels.into_iter().enumerate() {
         let at = (anchor, direction);
-        labels.push(label(Name::face(face.0), at, LabelKind::Partner, arm));
+        labels.push(label(panel_id(face), at, LabelKind::Partner, arm));
     }
     labels.push(label(
         Name::with_part(&ANGLE, tenths / 10, tenths % 10),
@@ -429,8 +443,8 @@ pub fn bracket_panel(bracket: &Bracket, label_height: f64) -> Panel {
     ));
     let facet: Loops = std::iter::once(0..bracket.points.len() as u32).collect();
     let source = Source {
-        id: Name::with_part(&BRACKET, bracket.edge.0, bracket.part),
-        covers: Covers::Inside(bracket.edge.0),
+        id: Name::with_part(&BRACKET, edge, bracket.part),
+        covers: Covers::Inside(edge),
     };
     Panel::new(source, bracket.points.clone(), facet, Vec::new(), labels)
 }
@@ -585,7 +599,7 @@ mod tests {
             thickness: 3.0,
             clearance: 0.1,
         };
-        let rigid = rigid_panels(&mesh, 3.0).expect("3 mm fits");
+        let rigid = rigid_panels(&mesh, &mesh, 3.0).expect("3 mm fits");
         let (brackets, bare) = clear_brackets(&mesh, &rigid.outlines, sizes);
         assert!(bare.is_empty(), "{bare:?}");
         assert_eq!(brackets.len(), 12, "one per edge under 250 mm");
@@ -622,7 +636,7 @@ mod tests {
             thickness: 3.0,
             clearance: 0.1,
         };
-        let rigid = rigid_panels(&mesh, 3.0).expect("3 mm fits");
+        let rigid = rigid_panels(&mesh, &mesh, 3.0).expect("3 mm fits");
         let (brackets, _) = clear_brackets(&mesh, &rigid.outlines, sizes);
         let face = FaceId(1);
         let slots: Vec<Slot> = brackets

@@ -14,6 +14,9 @@
 
 use glam::{DVec2, DVec3};
 
+use super::rigid_sheet::{
+    rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
+};
 use super::{
     args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
     SchemeOutput,
@@ -23,7 +26,6 @@ use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::{fill_arena, Arena, Hole, Label, LabelKind, Loops, Name, Panel, Panels, Source};
 use crate::plane::{area, clip_convex, distance_to_border};
 use crate::record::{round4, Params};
-use crate::units::fmt_num;
 
 /// A tab, in 3D: its base on the edge (inset from the corners) and the rest of its
 /// outline, plus the fastener holes through it and the neighbour.
@@ -95,24 +97,6 @@ impl Tabs {
 /// The half-edge scheme: one panel per face, tabs on interior edges.
 pub struct HalfEdge;
 
-/// Connector kinds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum Connectors {
-    /// A glue or pin tab on one of the two panels.
-    Tab,
-    /// Rigid sheet only: a flat bracket inside the model square to each edge, held in
-    /// slots through both panels.
-    Bracket,
-    /// Nothing: panels meet edge to edge.
-    None,
-}
-
-/// `--connectors`.
-const CONNECTORS: Connectors = Connectors::Tab;
-/// `--connectors` as `--help` states its default.
-const CONNECTORS_WORDS: &str = "tab, or bracket in rigid sheet (--thickness above zero)";
-/// `--slot-clearance`.
-const SLOT_CLEARANCE: &str = "0.1mm";
 /// `--tab-height`.
 const TAB_HEIGHT: &str = "8mm";
 
@@ -124,22 +108,11 @@ pub(super) fn tab_defaults() -> OptionDefault {
 /// The half-edge options as given.
 #[derive(Clone, Debug, Default, clap::Args)]
 struct HalfEdgeArgs {
-    /// Connectors on interior edges: tab or none.
-    #[arg(long, value_name = "KIND")]
-    connectors: Option<Connectors>,
+    #[command(flatten)]
+    rigid: RigidArgs,
 
     #[command(flatten)]
     tab: TabArgs,
-
-    /// Material thickness, with a unit: above zero the panels are rigid sheet, each
-    /// cut back from its edges and corners so that no two pass through each other.
-    #[arg(long, value_name = "LENGTH")]
-    thickness: Option<String>,
-
-    /// Play of a bracket's tab in its slot, with a unit: the slot is the thickness plus
-    /// this wide (and the tab's length plus this long).
-    #[arg(long, value_name = "LENGTH")]
-    slot_clearance: Option<String>,
 }
 
 /// The tab option of the schemes that glue tabs (half-edge, net), as given.
@@ -175,10 +148,8 @@ pub struct HalfEdgeOptions {
     pub tabs: bool,
     /// Wanted height of a tab's overlap with its neighbour (mm).
     pub tab_height: f64,
-    /// Material thickness (mm); above zero the panels are rigid.
-    pub thickness: f64,
-    /// Brackets between rigid panels, if wanted.
-    pub brackets: Option<super::bracket::BracketSizes>,
+    /// Rigid sheet: the thickness (zero for card) and what joins the panels.
+    pub rigid: RigidSheet,
 }
 
 impl Scheme for HalfEdge {
@@ -193,12 +164,7 @@ impl Scheme for HalfEdge {
     fn options(&self) -> Vec<clap::Arg> {
         state_defaults(
             args_of::<HalfEdgeArgs>(),
-            &[
-                OptionDefault::words("connectors", CONNECTORS_WORDS),
-                tab_defaults(),
-                super::thickness_default(),
-                OptionDefault::value("slot-clearance", SLOT_CLEARANCE),
-            ],
+            &[rigid_defaults().as_slice(), &[tab_defaults()]].concat(),
         )
     }
 
@@ -221,36 +187,12 @@ impl Scheme for HalfEdge {
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
         let args: HalfEdgeArgs = values.parse()?;
-        let thickness = super::thickness("thickness", args.thickness.as_deref(), "0mm", &panel)?;
-        let connectors = match (args.connectors, thickness > 0.0) {
-            (Some(Connectors::Tab), true) => {
-                return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); give --connectors bracket or none".to_string())
-            }
-            (Some(Connectors::Bracket), false) => {
-                return Err("--connectors bracket: brackets hold rigid panels; give the material's --thickness (3mm plywood: --thickness 3mm), or --connectors tab".to_string())
-            }
-            (Some(kind), _) => kind,
-            (None, true) => Connectors::Bracket,
-            (None, false) => CONNECTORS,
-        };
-        let clearance =
-            crate::units::parse_length(args.slot_clearance.as_deref().unwrap_or(SLOT_CLEARANCE))
-                .map_err(|e| format!("--slot-clearance: {e}"))?;
-        if !(0.0..10.0).contains(&clearance) {
-            return Err(format!("--slot-clearance: {clearance} mm must be at least 0 and below 10 mm (a tab's play in its slot)"));
-        }
-        if thickness > 0.0 && panel.face_scale != 1.0 {
-            return Err("--face-scale: rigid panels (--thickness above zero) meet at the faces' edges; leave --face-scale at 1".to_string());
-        }
+        let rigid = args.rigid.resolve(&panel)?;
         Ok(Box::new(HalfEdgeOptions {
             panel,
-            tabs: connectors == Connectors::Tab,
+            tabs: rigid.connectors == Connectors::Tab,
             tab_height: args.tab.height()?,
-            thickness,
-            brackets: (connectors == Connectors::Bracket).then_some(super::bracket::BracketSizes {
-                thickness,
-                clearance,
-            }),
+            rigid,
         }))
     }
 }
@@ -261,8 +203,9 @@ impl Configured for HalfEdgeOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        if self.thickness > 0.0 {
-            rigid_face_panels(mesh, self)
+        if self.rigid.thickness > 0.0 {
+            let names = PanelNames::of_faces(mesh);
+            rigid_output(mesh, mesh, &self.rigid, &self.panel, &names)
         } else {
             Ok(panels(mesh, self))
         }
@@ -270,17 +213,9 @@ impl Configured for HalfEdgeOptions {
 
     fn params(&self) -> Params {
         let mut params = Params::default();
-        let connectors = match (self.tabs, self.brackets.is_some()) {
-            (true, _) => "tab",
-            (false, true) => "bracket",
-            (false, false) => "none",
-        };
-        params.push("connectors", connectors);
+        params.push("connectors", self.rigid.connectors_name());
         params.push("tab_height", round4(self.tab_height));
-        params.push("thickness", round4(self.thickness));
-        if let Some(sizes) = self.brackets {
-            params.push("slot_clearance", round4(sizes.clearance));
-        }
+        self.rigid.sheet_params(&mut params);
         params
     }
 }
@@ -477,16 +412,24 @@ fn face_labels(
         .face_half_edges(f)
         .enumerate()
         .filter(|&(_, h)| !options.tabs || tab_of(h).is_some())
-        .filter_map(|(k, h)| Some((k, mesh.face(h.twin())?)));
-    outline_labels(f, band, partners, options.panel.label_height)
+        .filter_map(|(k, h)| Some((k, panel_id(mesh.face(h.twin())?))));
+    let centre = band.iter().copied().sum::<DVec3>() / band.len() as f64;
+    outline_labels(
+        panel_id(f),
+        centre,
+        band,
+        partners,
+        options.panel.label_height,
+    )
 }
 
-/// The labels of face `f`'s panel of outline `points`: its id at the centre, along the
-/// longest side; each partner's id inside the side `(k, partner)` it joins at.
-fn outline_labels(
-    f: FaceId,
+/// The labels of a panel of outline `points`: its id at `anchor`, along the longest
+/// side; each partner's id inside the side `(k, partner)` it joins at.
+pub(super) fn outline_labels(
+    id: Name,
+    anchor: DVec3,
     points: &[DVec3],
-    partners: impl Iterator<Item = (usize, FaceId)>,
+    partners: impl Iterator<Item = (usize, Name)>,
     height: f64,
 ) -> Vec<Label> {
     let n = points.len();
@@ -497,10 +440,9 @@ fn outline_labels(
             li.total_cmp(&lj).then(j.cmp(&i))
         })
         .unwrap_or(0);
-    let centre = points.iter().copied().sum::<DVec3>() / n as f64;
     let mut labels = vec![Label {
-        text: panel_id(f),
-        anchor: centre,
+        text: id,
+        anchor,
         direction: (points[(longest + 1) % n] - points[longest]).normalize(),
         height,
         facet: 0,
@@ -508,10 +450,10 @@ fn outline_labels(
         on_edge: false,
         slide: 0.0,
     }];
-    for (k, g) in partners {
+    for (k, partner) in partners {
         let (a, b) = (points[k], points[(k + 1) % n]);
         labels.push(Label {
-            text: panel_id(g),
+            text: partner,
             anchor: 0.5 * (a + b),
             direction: (b - a).normalize(),
             height,
@@ -523,140 +465,6 @@ fn outline_labels(
         });
     }
     labels
-}
-
-/// The face panels in rigid sheet: each face's outline cut back so that no two panels
-/// pass through each other, meeting edge to edge.
-fn rigid_face_panels(mesh: &Mesh, options: &HalfEdgeOptions) -> Result<SchemeOutput, SchemeError> {
-    let t = options.thickness;
-    let rigid = super::rigid::rigid_panels(mesh, t)
-        .map_err(|e| too_thick(mesh, t, options.panel.scale, &e))?;
-    let (brackets, bare) = match options.brackets {
-        Some(sizes) => super::bracket::clear_brackets(mesh, &rigid.outlines, sizes),
-        None => (Vec::new(), Vec::new()),
-    };
-    let mut slots: Vec<Vec<super::bracket::Slot>> = vec![Vec::new(); mesh.face_count()];
-    for slot in brackets.iter().flat_map(|b| b.slots) {
-        if let Some(f) = mesh.face(slot.side) {
-            slots[f.0 as usize].push(slot);
-        }
-    }
-    let mut panels = Panels::build(mesh.face_count(), |f| {
-        let outline = &rigid.outlines[f];
-        let partners = outline
-            .along
-            .iter()
-            .enumerate()
-            .filter_map(|(k, h)| Some((k, mesh.face((*h)?.twin())?)));
-        let face = FaceId(f as u32);
-        let labels = outline_labels(face, &outline.points, partners, options.panel.label_height);
-        let (vertices, facets) = super::bracket::slotted_facets(mesh, outline, &slots[f]);
-        Panel::new(Source::face(face.0), vertices, facets, Vec::new(), labels)
-    });
-    for bracket in &brackets {
-        let panel = super::bracket::bracket_panel(bracket, options.panel.label_height);
-        panels.push(panel.view());
-    }
-    let widest_corner = rigid.vertices_cut.iter().map(|c| c.1).fold(0.0, f64::max);
-    let mut report = vec![format!(
-        "rigid panels {} mm thick: {} edges cut back (up to {} mm), corners cut back at {} vertices (up to {} mm from the vertex)",
-        fmt_num(t),
-        rigid.edges_cut,
-        fmt_num(rigid.widest_edge_cut),
-        rigid.vertices_cut.len(),
-        fmt_num(widest_corner)
-    )];
-    let mut notes = Vec::new();
-    if options.brackets.is_some() {
-        report.push(format!(
-            "brackets: {} (ids B<edge>.<n>, the angle between the arms engraved), slots {} mm wide",
-            brackets.len(),
-            fmt_num(t + options.brackets.map_or(0.0, |b| b.clearance))
-        ));
-        if !bare.is_empty() {
-            let named: Vec<String> = bare
-                .iter()
-                .take(5)
-                .map(|e| Name::edge(e.0).to_string())
-                .collect();
-            notes.push(format!(
-                "{} interior edges have no bracket ({}{}): their panels have no room for a slot's collar there, or an arm would meet another part; glue them, or build larger",
-                bare.len(),
-                named.join(", "),
-                if bare.len() > 5 { ", …" } else { "" }
-            ));
-        }
-    }
-    let mut section = serde_json::Map::new();
-    section.insert("thickness".into(), round4(t).into());
-    section.insert("edges_cut".into(), rigid.edges_cut.into());
-    section.insert(
-        "widest_edge_cut".into(),
-        round4(rigid.widest_edge_cut).into(),
-    );
-    section.insert("vertices_cut".into(), rigid.vertices_cut.len().into());
-    section.insert("widest_vertex_cut".into(), round4(widest_corner).into());
-    if options.brackets.is_some() {
-        section.insert("brackets".into(), brackets.len().into());
-        section.insert("edges_without_bracket".into(), bare.len().into());
-    }
-    let mut manifest = Params::default();
-    manifest.push("rigid", serde_json::Value::Object(section));
-    Ok(SchemeOutput {
-        panels,
-        connections: brackets.len(),
-        notes,
-        report,
-        manifest,
-        thickness: t,
-        ..SchemeOutput::default()
-    })
-}
-
-/// The refusal of a thickness the model cannot take at its size, naming the thickness
-/// that fits and the size that takes this one.
-fn too_thick(
-    mesh: &Mesh,
-    thickness: f64,
-    scale: f64,
-    error: &super::rigid::RigidError,
-) -> SchemeError {
-    use super::rigid::RigidError;
-    let what = match error {
-        RigidError::NoRoom { face } => format!(
-            "face {} has no panel left once cut back from its edges and corners",
-            panel_id(*face)
-        ),
-        RigidError::SticksOut { face, depth } => format!(
-            "the panel of {} would stick out of the model by {} mm",
-            panel_id(*face),
-            fmt_num(*depth)
-        ),
-        RigidError::Overlap { faces, depth } => format!(
-            "the panels of {} and {} would pass {} mm into each other",
-            panel_id(faces[0]),
-            panel_id(faces[1]),
-            fmt_num(*depth)
-        ),
-    };
-    let fits = super::rigid::thickest(mesh, thickness);
-    if fits < 1e-3 * thickness {
-        // Insets and cuts grow with the thickness: what fails at every thickness is
-        // the shape itself.
-        return SchemeError::Options(format!(
-            "--thickness {}mm: {what}, and would at any thickness (the faces meet too sharply there for square-cut panels); a simpler model (--target-edges) or another scheme may build",
-            fmt_num(thickness)
-        ));
-    }
-    // Scaling the model up by k takes k times the thickness (`--size` comes before
-    // `--scale`).
-    let size = mesh.longest_side() * thickness / fits / scale;
-    SchemeError::Options(format!(
-        "--thickness {}mm is too thick for this model at this size: {what}; --thickness {}mm fits, or --size {}mm takes it",
-        fmt_num(thickness),
-        fmt_num((fits * 1e3).floor() / 1e3),
-        (size * 1.001).ceil()
-    ))
 }
 
 /// The tab that the face of `owner` (a → b) folds onto the neighbour across it, or
@@ -812,8 +620,7 @@ mod tests {
             },
             tabs: true,
             tab_height,
-            thickness: 0.0,
-            brackets: None,
+            rigid: super::super::rigid_sheet::RigidSheet::CARD,
         }
     }
 

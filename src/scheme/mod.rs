@@ -14,6 +14,7 @@ pub mod half_edge;
 pub mod net;
 pub mod quad_edge;
 pub mod rigid;
+pub mod rigid_sheet;
 pub mod sandwich;
 pub mod strip;
 pub mod winged_edge;
@@ -507,7 +508,7 @@ impl SchemeError {
 pub(super) fn thickness_default() -> crate::option_default::OptionDefault {
     crate::option_default::OptionDefault::words(
         "thickness",
-        "0mm for half-edge, quad-edge and winged-edge, 0.1in for woven",
+        "0mm for half-edge, net, quad-edge and winged-edge, 0.1in for woven",
     )
 }
 

@@ -26,8 +26,12 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3};
 
 use super::half_edge::{make_tab, tab_defaults, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
+use super::rigid_sheet::{
+    rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
+};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
+use crate::mesh::coplanar::{flat_regions, RegionRules};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::surface::group_anchor;
@@ -110,6 +114,9 @@ struct NetArgs {
     #[command(flatten)]
     tab: TabArgs,
 
+    #[command(flatten)]
+    rigid: RigidArgs,
+
     /// Most faces in one island (net scheme), for builders who want small pieces.
     #[arg(long, value_name = "N")]
     max_island_faces: Option<usize>,
@@ -137,6 +144,9 @@ pub struct NetOptions {
     pub flat_fold: f64,
     /// Largest ratio of an island's convex hull to its area.
     pub island_spread: f64,
+    /// Rigid sheet: above zero thickness nothing folds, and each island is a flat
+    /// region of the model.
+    pub rigid: RigidSheet,
 }
 
 impl Scheme for Net {
@@ -156,7 +166,10 @@ impl Scheme for Net {
                 OptionDefault::words("max-island-faces", "no limit"),
                 OptionDefault::value("flat-fold", FLAT_FOLD_DEG),
                 OptionDefault::value("island-spread", ISLAND_SPREAD),
-            ],
+            ]
+            .into_iter()
+            .chain(rigid_defaults())
+            .collect::<Vec<_>>(),
         )
     }
 
@@ -194,12 +207,20 @@ impl Scheme for Net {
                 "--island-spread: {island_spread} must be a number of at least 1 (a convex island has 1)"
             ));
         }
+        let rigid = args.rigid.resolve(&panel)?;
+        if rigid.connectors == Connectors::None && rigid.thickness == 0.0 {
+            return Err("--connectors none: the net scheme glues its cuts with tabs in card; none is for rigid sheet (--thickness)".into());
+        }
+        if rigid.thickness > 0.0 && args.island_spread.is_some() {
+            return Err("--island-spread: in rigid sheet (--thickness) nothing folds, so each island is a flat region of the model, whatever its shape; leave --island-spread out".into());
+        }
         Ok(Box::new(NetOptions {
             island_spread,
             panel,
             tab_height: args.tab.height()?,
             max_island_faces: args.max_island_faces,
             flat_fold: args.flat_fold.angle()?,
+            rigid,
         }))
     }
 }
@@ -210,7 +231,11 @@ impl Configured for NetOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        Ok(panels(mesh, self))
+        if self.rigid.thickness > 0.0 {
+            rigid_panels(mesh, self)
+        } else {
+            Ok(panels(mesh, self))
+        }
     }
 
     fn params(&self) -> Params {
@@ -222,6 +247,8 @@ impl Configured for NetOptions {
         }
         params.push("flat_fold_deg", round4(self.flat_fold.to_degrees()));
         params.push("island_spread", self.island_spread);
+        params.push("connectors", self.rigid.connectors_name());
+        self.rigid.sheet_params(&mut params);
         params
     }
 
@@ -721,8 +748,7 @@ fn tab_options(options: &NetOptions, height: f64) -> HalfEdgeOptions {
         panel: options.panel.clone(),
         tabs: true,
         tab_height: height,
-        thickness: 0.0,
-        brackets: None,
+        rigid: super::rigid_sheet::RigidSheet::CARD,
     }
 }
 
@@ -989,6 +1015,99 @@ pub fn panels(mesh: &Mesh, options: &NetOptions) -> SchemeOutput {
     output.report = net.summary.report("net", "islands");
     output.manifest.push("net", net.summary.section("islands"));
     output
+}
+
+/// How far (mm) a face's corners may lie off the plane of its flat region in rigid
+/// sheet: the panel is flat, so this is how far it may stand off the model.
+const FLAT_REGION_TOLERANCE: f64 = 0.005;
+
+/// The net in rigid sheet: nothing folds, so each island is a flat region of the model
+/// (neighbouring faces in one plane), cut back and held like the half-edge scheme's
+/// faces.
+fn rigid_panels(mesh: &Mesh, options: &NetOptions) -> Result<SchemeOutput, SchemeError> {
+    let fits = |corners: &[DVec2]| {
+        let hull = convex_hull(corners);
+        fits_sheet(&hull, options, FIT_SLACK).then_some(hull)
+    };
+    let rules = RegionRules {
+        tolerance: FLAT_REGION_TOLERANCE,
+        max_faces: options.max_island_faces.unwrap_or(usize::MAX),
+        fits: &fits,
+    };
+    let regions = flat_regions(mesh, &rules).map_err(|e| {
+        SchemeError::Model(format!(
+            "the net scheme could not merge the model's flat regions ({e}); --scheme half-edge builds each face on its own"
+        ))
+    })?;
+    let anchors: Vec<DVec3> = regions
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(k, faces)| region_anchor(&regions.mesh, FaceId(k as u32), mesh, faces))
+        .collect();
+    let names = PanelNames {
+        sources: (0..regions.faces.len() as u32)
+            .map(|k| Source {
+                id: Name::new(&ISLAND, k + 1),
+                covers: Covers::Faces(k),
+            })
+            .collect(),
+        anchors: anchors.clone(),
+        edge_numbers: regions.edge_source.clone(),
+    };
+    let mut output = rigid_output(&regions.mesh, mesh, &options.rigid, &options.panel, &names)?;
+    let mut sizes: Vec<usize> = regions.faces.iter().map(Vec::len).collect();
+    sizes.sort_unstable();
+    let merged = regions.faces.iter().filter(|f| f.len() > 1).count();
+    output.report.insert(
+        0,
+        format!(
+            "net in rigid sheet: {} islands, each a flat region of the model ({} of several faces, largest {} faces)",
+            regions.faces.len(),
+            merged,
+            sizes.last().copied().unwrap_or(0)
+        ),
+    );
+    output.manifest.push(
+        "net",
+        serde_json::json!({
+            "islands": regions.faces.len(),
+            "largest_island_faces": sizes.last().copied().unwrap_or(0),
+            "median_island_faces": sizes.get(sizes.len() / 2).copied().unwrap_or(0),
+        }),
+    );
+    output.face_groups = regions
+        .faces
+        .into_iter()
+        .zip(anchors)
+        .map(|(faces, anchor)| FaceGroup { anchor, faces })
+        .collect();
+    Ok(output)
+}
+
+/// Where a flat region's id goes: the centroid of its polygon (face `k` of `merged`)
+/// when that lies inside it, else the centre of its middle face.
+fn region_anchor(merged: &Mesh, k: FaceId, mesh: &Mesh, faces: &[u32]) -> DVec3 {
+    let corners: Vec<DVec3> = merged.face_positions(k).collect();
+    let normal = merged.face_normal(k);
+    let x = normal.any_orthonormal_vector();
+    let y = normal.cross(x);
+    let flat: Vec<DVec2> = corners
+        .iter()
+        .map(|&p| DVec2::new((p - corners[0]).dot(x), (p - corners[0]).dot(y)))
+        .collect();
+    let (mut weighted, mut total) = (DVec2::ZERO, 0.0);
+    for i in 1..flat.len().saturating_sub(1) {
+        let area = (flat[i] - flat[0]).perp_dot(flat[i + 1] - flat[0]);
+        weighted += area * (flat[0] + flat[i] + flat[i + 1]) / 3.0;
+        total += area;
+    }
+    let centroid = weighted / total;
+    if total > 0.0 && crate::plane::contains(&flat, centroid) {
+        corners[0] + centroid.x * x + centroid.y * y
+    } else {
+        group_anchor(mesh, faces)
+    }
 }
 
 /// How a net's islands are named and what of the model they cover.
@@ -1540,6 +1659,7 @@ mod tests {
             max_island_faces,
             flat_fold: 1f64.to_radians(),
             island_spread: ISLAND_SPREAD,
+            rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
         }
     }
 

@@ -94,8 +94,13 @@ pub fn interior_angle(mesh: &Mesh, h: HalfedgeId) -> f64 {
     PI - na.cross(nb).dot(along).atan2(na.dot(nb))
 }
 
-/// The rigid panels of every face of `mesh` in material `thickness` mm thick.
-pub fn rigid_panels(mesh: &Mesh, thickness: f64) -> Result<RigidPanels, RigidError> {
+/// The rigid panels of every face of `mesh` in material `thickness` mm thick, kept
+/// inside `surface` (the model's own faces, which `mesh` may merge into larger ones).
+pub fn rigid_panels(
+    mesh: &Mesh,
+    surface: &Mesh,
+    thickness: f64,
+) -> Result<RigidPanels, RigidError> {
     let insets = edge_insets(mesh, thickness);
     let frames: Vec<FaceFrame> = mesh.faces().map(|f| FaceFrame::of(mesh, f)).collect();
     let mut outlines = Vec::with_capacity(mesh.face_count());
@@ -104,7 +109,7 @@ pub fn rigid_panels(mesh: &Mesh, thickness: f64) -> Result<RigidPanels, RigidErr
             .ok_or(RigidError::NoRoom { face: f })?;
         outlines.push(outline);
     }
-    let solid = Solid::of(mesh);
+    let solid = Solid::of(surface);
     let mut vertices_cut = Vec::new();
     for v in mesh.vertices() {
         let at = Corner {
@@ -141,11 +146,11 @@ pub fn rigid_panels(mesh: &Mesh, thickness: f64) -> Result<RigidPanels, RigidErr
 
 /// The largest thickness up to `thickness` for which [`rigid_panels`] succeeds,
 /// found by halving (to a thousandth of `thickness`).
-pub fn thickest(mesh: &Mesh, thickness: f64) -> f64 {
+pub fn thickest(mesh: &Mesh, surface: &Mesh, thickness: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, thickness);
     while hi - lo > 1e-3 * thickness {
         let mid = 0.5 * (lo + hi);
-        if rigid_panels(mesh, mid).is_ok() {
+        if rigid_panels(mesh, surface, mid).is_ok() {
             lo = mid;
         } else {
             hi = mid;
@@ -587,7 +592,11 @@ impl CornerFrame {
 
     /// The part of `outline` near this corner.
     fn near(&self, outline: &FlatOutline) -> FlatOutline {
-        clip_outline(outline, self.at + self.reach * self.inward, -self.inward)
+        let side = |p: DVec2| (p - self.at).dot(self.inward) - self.reach;
+        match side_run(outline, self.at, |p| side(p) <= 0.0) {
+            Some((from, to)) => keep_between(outline, from, to, side),
+            None => outline.clone(),
+        }
     }
 }
 
@@ -601,7 +610,16 @@ fn cut_corner(
     outline: &FlatOutline,
     r: f64,
 ) -> Option<FlatOutline> {
-    let cut = clip_outline(outline, corner.at + r * corner.inward, corner.inward);
+    let side = |p: DVec2| (p - corner.at).dot(corner.inward) - r;
+    let cut = match side_run(outline, corner.at, |p| side(p) < 0.0) {
+        // The corner's own points inside the cut go; the rest of the outline stays,
+        // however far round it comes back (a region's outline need not be convex).
+        Some((from, to)) => {
+            let m = outline.points.len();
+            keep_between(outline, (to + 1) % m, (from + m - 1) % m, side)
+        }
+        None => outline.clone(),
+    };
     let sides_kept = outline
         .along
         .iter()
@@ -622,31 +640,71 @@ fn cut_corner(
     .then_some(cut)
 }
 
-/// The part of an outline where `(p - at)·inward >= 0`, the cut a side of its own.
-fn clip_outline(outline: &FlatOutline, at: DVec2, inward: DVec2) -> FlatOutline {
+/// The run of outline points, from the one nearest `vertex` on both ways round, for
+/// which `inside` holds: (first, last) in outline order, the whole outline when all
+/// hold; `None` when the nearest point is not inside (or all are, for no run to end).
+fn side_run(
+    outline: &FlatOutline,
+    vertex: DVec2,
+    inside: impl Fn(DVec2) -> bool,
+) -> Option<(usize, usize)> {
     let m = outline.points.len();
-    let side = |p: DVec2| (p - at).dot(inward);
-    let mut clipped = FlatOutline {
-        points: Vec::with_capacity(m + 1),
-        along: Vec::with_capacity(m + 1),
-    };
-    for i in 0..m {
+    let nearest = (0..m).min_by(|&i, &j| {
+        let (a, b) = (outline.points[i], outline.points[j]);
+        a.distance(vertex)
+            .total_cmp(&b.distance(vertex))
+            .then(i.cmp(&j))
+    })?;
+    if !inside(outline.points[nearest]) {
+        return None;
+    }
+    let (mut from, mut to) = (nearest, nearest);
+    let mut count = 1;
+    while count < m && inside(outline.points[(from + m - 1) % m]) {
+        from = (from + m - 1) % m;
+        count += 1;
+    }
+    while count < m && inside(outline.points[(to + 1) % m]) {
+        to = (to + 1) % m;
+        count += 1;
+    }
+    (count < m).then_some((from, to))
+}
+
+/// The outline's points `from..=to` (in order round it), closed by a cut where the
+/// outline crosses `side` = 0 after `to` and before `from`; the cut is a side of its
+/// own.
+fn keep_between(
+    outline: &FlatOutline,
+    from: usize,
+    to: usize,
+    side: impl Fn(DVec2) -> f64,
+) -> FlatOutline {
+    let m = outline.points.len();
+    let crossing = |i: usize| {
         let (p, q) = (outline.points[i], outline.points[(i + 1) % m]);
         let (sp, sq) = (side(p), side(q));
-        if sp >= 0.0 {
-            clipped.points.push(p);
-            clipped.along.push(outline.along[i]);
+        p + (q - p) * (sp / (sp - sq))
+    };
+    let mut kept = FlatOutline {
+        points: Vec::with_capacity(m + 2),
+        along: Vec::with_capacity(m + 2),
+    };
+    let mut i = from;
+    loop {
+        kept.points.push(outline.points[i]);
+        kept.along.push(outline.along[i]);
+        if i == to {
+            break;
         }
-        if (sp >= 0.0) != (sq >= 0.0) {
-            let crossing = p + (q - p) * (sp / (sp - sq));
-            clipped.points.push(crossing);
-            // Leaving the kept part, the cut runs on to where the outline comes back.
-            clipped
-                .along
-                .push(if sp >= 0.0 { None } else { outline.along[i] });
-        }
+        i = (i + 1) % m;
     }
-    clipped
+    let before = (from + m - 1) % m;
+    kept.points.push(crossing(to));
+    kept.along.push(None);
+    kept.points.push(crossing(before));
+    kept.along.push(outline.along[before]);
+    kept
 }
 
 /// No two panels overlap anywhere, the ones far apart in the mesh included (a wall
@@ -861,7 +919,7 @@ mod tests {
             let delta = interior_angle(&mesh, e.half_edge());
             assert!((delta - FRAC_PI_2).abs() < 1e-9, "{delta}");
         }
-        let rigid = rigid_panels(&mesh, 3.0).expect("a 100 mm cube takes 3 mm");
+        let rigid = rigid_panels(&mesh, &mesh, 3.0).expect("a 100 mm cube takes 3 mm");
         assert_eq!(rigid.edges_cut, 12);
         assert!((rigid.widest_edge_cut - 3.0).abs() < 1e-9);
         assert!(rigid.vertices_cut.is_empty(), "{:?}", rigid.vertices_cut);
@@ -885,12 +943,12 @@ mod tests {
     fn too_thick_for_a_small_cube_is_refused_and_the_thickest_found() {
         let mesh = cube(10.0);
         assert!(matches!(
-            rigid_panels(&mesh, 6.0),
+            rigid_panels(&mesh, &mesh, 6.0),
             Err(RigidError::NoRoom { .. })
         ));
-        let t = thickest(&mesh, 6.0);
+        let t = thickest(&mesh, &mesh, 6.0);
         assert!(t > 4.0 && t < 5.0, "{t}");
-        assert!(rigid_panels(&mesh, t).is_ok());
+        assert!(rigid_panels(&mesh, &mesh, t).is_ok());
     }
 
     #[test]

@@ -181,6 +181,7 @@ impl Scheme for Strips {
         };
         Ok(Box::new(StripOptions {
             net: NetOptions {
+                rigid: super::rigid_sheet::RigidSheet::CARD,
                 panel,
                 tab_height: args.tab.height()?,
                 max_island_faces: None,

@@ -1,0 +1,307 @@
+//! Rigid sheet as a scheme's output, for the schemes whose panels can be flat parts
+//! (half-edge: one per face; net: one per flat region): the options, the panels cut
+//! back by [`super::rigid`] and held by [`super::bracket`]s, their labels, the report
+//! and the refusal of a thickness the model cannot take.
+
+use glam::DVec3;
+
+use super::bracket::{bracket_panel, clear_brackets, slotted_facets, BracketSizes, Slot};
+use super::half_edge::outline_labels;
+use super::rigid::{rigid_panels, thickest, RigidError};
+use super::{PanelOptions, SchemeError, SchemeOutput};
+use crate::mesh::{FaceId, Mesh};
+use crate::option_default::OptionDefault;
+use crate::panel::{Name, Panel, Panels, Source};
+use crate::record::{round4, Params};
+use crate::units::fmt_num;
+
+/// Connector kinds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Connectors {
+    /// A glue or pin tab on one of the two panels.
+    Tab,
+    /// Rigid sheet only: a flat bracket inside the model square to each edge, held in
+    /// slots through both panels.
+    Bracket,
+    /// Nothing: panels meet edge to edge.
+    None,
+}
+
+/// `--connectors` as `--help` states its default.
+const CONNECTORS_WORDS: &str = "tab, or bracket in rigid sheet (--thickness above zero)";
+/// `--slot-clearance`.
+const SLOT_CLEARANCE: &str = "0.1mm";
+
+/// The rigid sheet options (half-edge, net), as given.
+#[derive(Clone, Debug, Default, clap::Args)]
+pub(super) struct RigidArgs {
+    /// Connectors on interior edges: tab, bracket (rigid sheet) or none.
+    #[arg(long, value_name = "KIND")]
+    connectors: Option<Connectors>,
+
+    /// Material thickness, with a unit: above zero the panels are rigid sheet, each
+    /// cut back from its edges and corners so that no two pass through each other.
+    #[arg(long, value_name = "LENGTH")]
+    thickness: Option<String>,
+
+    /// Play of a bracket's tab in its slot, with a unit: the slot is the thickness plus
+    /// this wide (and the tab's length plus this long).
+    #[arg(long, value_name = "LENGTH")]
+    slot_clearance: Option<String>,
+}
+
+/// The defaults of the rigid sheet options, for the `options()` of the schemes that
+/// take them.
+pub(super) fn rigid_defaults() -> [OptionDefault; 3] {
+    [
+        OptionDefault::words("connectors", CONNECTORS_WORDS),
+        super::thickness_default(),
+        OptionDefault::value("slot-clearance", SLOT_CLEARANCE),
+    ]
+}
+
+/// The rigid sheet options, resolved (lengths in mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RigidSheet {
+    /// Material thickness (mm); above zero the panels are rigid.
+    pub thickness: f64,
+    /// What joins the panels.
+    pub connectors: Connectors,
+    /// Brackets between rigid panels, if wanted.
+    pub brackets: Option<BracketSizes>,
+}
+
+impl RigidArgs {
+    /// The options, checked: tabs only in card, brackets only in rigid sheet.
+    pub(super) fn resolve(&self, panel: &PanelOptions) -> Result<RigidSheet, String> {
+        let thickness = super::thickness("thickness", self.thickness.as_deref(), "0mm", panel)?;
+        let connectors = match (self.connectors, thickness > 0.0) {
+            (Some(Connectors::Tab), true) => {
+                return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); give --connectors bracket or none".to_string())
+            }
+            (Some(Connectors::Bracket), false) => {
+                return Err("--connectors bracket: brackets hold rigid panels; give the material's --thickness (3mm plywood: --thickness 3mm), or --connectors tab".to_string())
+            }
+            (Some(kind), _) => kind,
+            (None, true) => Connectors::Bracket,
+            (None, false) => Connectors::Tab,
+        };
+        let clearance =
+            crate::units::parse_length(self.slot_clearance.as_deref().unwrap_or(SLOT_CLEARANCE))
+                .map_err(|e| format!("--slot-clearance: {e}"))?;
+        if !(0.0..10.0).contains(&clearance) {
+            return Err(format!("--slot-clearance: {clearance} mm must be at least 0 and below 10 mm (a tab's play in its slot)"));
+        }
+        if thickness > 0.0 && panel.face_scale != 1.0 {
+            return Err("--face-scale: rigid panels (--thickness above zero) meet at the faces' edges; leave --face-scale at 1".to_string());
+        }
+        Ok(RigidSheet {
+            thickness,
+            connectors,
+            brackets: (connectors == Connectors::Bracket).then_some(BracketSizes {
+                thickness,
+                clearance,
+            }),
+        })
+    }
+}
+
+impl RigidSheet {
+    /// Card: no thickness, tabs.
+    pub const CARD: RigidSheet = RigidSheet {
+        thickness: 0.0,
+        connectors: Connectors::Tab,
+        brackets: None,
+    };
+
+    /// `--connectors` as the manifest records it.
+    pub(super) fn connectors_name(&self) -> &'static str {
+        match self.connectors {
+            Connectors::Tab => "tab",
+            Connectors::Bracket => "bracket",
+            Connectors::None => "none",
+        }
+    }
+
+    /// The thickness and, with brackets, the slot clearance, as the manifest records
+    /// them.
+    pub(super) fn sheet_params(&self, params: &mut Params) {
+        params.push("thickness", round4(self.thickness));
+        if let Some(sizes) = self.brackets {
+            params.push("slot_clearance", round4(sizes.clearance));
+        }
+    }
+}
+
+/// What the panels of a rigid build's faces are called and where their ids go.
+pub(super) struct PanelNames {
+    /// Each face's panel.
+    pub sources: Vec<Source>,
+    /// Where each face's panel id goes (a point inside the face).
+    pub anchors: Vec<DVec3>,
+    /// Each edge's number in the user's model (brackets and notes name it).
+    pub edge_numbers: Vec<u32>,
+}
+
+impl PanelNames {
+    /// A panel per face, `F<f>` at its centre; edges as they are.
+    pub(super) fn of_faces(mesh: &Mesh) -> PanelNames {
+        PanelNames {
+            sources: mesh.faces().map(|f| Source::face(f.0)).collect(),
+            anchors: mesh.faces().map(|f| mesh.face_centre(f)).collect(),
+            edge_numbers: mesh.edges().map(|e| e.0).collect(),
+        }
+    }
+
+    fn id(&self, f: FaceId) -> Name {
+        self.sources[f.index()].id
+    }
+}
+
+/// The panels of `mesh`'s faces in rigid sheet, kept inside `surface` (the model's
+/// own faces): each face's outline cut back so that no two panels pass through each
+/// other, meeting edge to edge, with brackets if asked.
+pub(super) fn rigid_output(
+    mesh: &Mesh,
+    surface: &Mesh,
+    sheet: &RigidSheet,
+    panel: &PanelOptions,
+    names: &PanelNames,
+) -> Result<SchemeOutput, SchemeError> {
+    let t = sheet.thickness;
+    let rigid = rigid_panels(mesh, surface, t)
+        .map_err(|e| too_thick(mesh, surface, t, panel.scale, &e, names))?;
+    let (brackets, bare) = match sheet.brackets {
+        Some(sizes) => clear_brackets(mesh, &rigid.outlines, sizes),
+        None => (Vec::new(), Vec::new()),
+    };
+    let mut slots: Vec<Vec<Slot>> = vec![Vec::new(); mesh.face_count()];
+    for slot in brackets.iter().flat_map(|b| b.slots) {
+        if let Some(f) = mesh.face(slot.side) {
+            slots[f.0 as usize].push(slot);
+        }
+    }
+    let mut panels = Panels::build(mesh.face_count(), |f| {
+        let outline = &rigid.outlines[f];
+        let partners = outline
+            .along
+            .iter()
+            .enumerate()
+            .filter_map(|(k, h)| Some((k, names.id(mesh.face((*h)?.twin())?))));
+        let labels = outline_labels(
+            names.sources[f].id,
+            names.anchors[f],
+            &outline.points,
+            partners,
+            panel.label_height,
+        );
+        let (vertices, facets) = slotted_facets(mesh, outline, &slots[f]);
+        Panel::new(names.sources[f], vertices, facets, Vec::new(), labels)
+    });
+    for bracket in &brackets {
+        let edge = names.edge_numbers[bracket.edge.index()];
+        let id = |f: FaceId| names.id(f);
+        panels.push(bracket_panel(bracket, panel.label_height, edge, &id).view());
+    }
+    let widest_corner = rigid.vertices_cut.iter().map(|c| c.1).fold(0.0, f64::max);
+    let mut report = vec![format!(
+        "rigid panels {} mm thick: {} edges cut back (up to {} mm), corners cut back at {} vertices (up to {} mm from the vertex)",
+        fmt_num(t),
+        rigid.edges_cut,
+        fmt_num(rigid.widest_edge_cut),
+        rigid.vertices_cut.len(),
+        fmt_num(widest_corner)
+    )];
+    let mut notes = Vec::new();
+    if let Some(sizes) = sheet.brackets {
+        report.push(format!(
+            "brackets: {} (ids B<edge>.<n>, the angle between the arms engraved), slots {} mm wide",
+            brackets.len(),
+            fmt_num(t + sizes.clearance)
+        ));
+        if !bare.is_empty() {
+            let named: Vec<String> = bare
+                .iter()
+                .take(5)
+                .map(|e| Name::edge(names.edge_numbers[e.index()]).to_string())
+                .collect();
+            notes.push(format!(
+                "{} interior edges have no bracket ({}{}): their panels have no room for a slot's collar there, or an arm would meet another part; glue them, or build larger",
+                bare.len(),
+                named.join(", "),
+                if bare.len() > 5 { ", …" } else { "" }
+            ));
+        }
+    }
+    let mut section = serde_json::Map::new();
+    section.insert("thickness".into(), round4(t).into());
+    section.insert("edges_cut".into(), rigid.edges_cut.into());
+    section.insert(
+        "widest_edge_cut".into(),
+        round4(rigid.widest_edge_cut).into(),
+    );
+    section.insert("vertices_cut".into(), rigid.vertices_cut.len().into());
+    section.insert("widest_vertex_cut".into(), round4(widest_corner).into());
+    if sheet.brackets.is_some() {
+        section.insert("brackets".into(), brackets.len().into());
+        section.insert("edges_without_bracket".into(), bare.len().into());
+    }
+    let mut manifest = Params::default();
+    manifest.push("rigid", serde_json::Value::Object(section));
+    Ok(SchemeOutput {
+        panels,
+        connections: brackets.len(),
+        notes,
+        report,
+        manifest,
+        thickness: t,
+        ..SchemeOutput::default()
+    })
+}
+
+/// The refusal of a thickness the model cannot take at its size, naming the thickness
+/// that fits and the size that takes this one.
+fn too_thick(
+    mesh: &Mesh,
+    surface: &Mesh,
+    thickness: f64,
+    scale: f64,
+    error: &RigidError,
+    names: &PanelNames,
+) -> SchemeError {
+    let what = match error {
+        RigidError::NoRoom { face } => format!(
+            "{} has no panel left once cut back from its edges and corners",
+            names.id(*face)
+        ),
+        RigidError::SticksOut { face, depth } => format!(
+            "the panel of {} would stick out of the model by {} mm",
+            names.id(*face),
+            fmt_num(*depth)
+        ),
+        RigidError::Overlap { faces, depth } => format!(
+            "the panels of {} and {} would pass {} mm into each other",
+            names.id(faces[0]),
+            names.id(faces[1]),
+            fmt_num(*depth)
+        ),
+    };
+    let fits = thickest(mesh, surface, thickness);
+    if fits < 1e-3 * thickness {
+        // Insets and cuts grow with the thickness: what fails at every thickness is
+        // the shape itself.
+        return SchemeError::Options(format!(
+            "--thickness {}mm: {what}, and would at any thickness (the faces meet too sharply there for square-cut panels); a simpler model (--target-edges) or another scheme may build",
+            fmt_num(thickness)
+        ));
+    }
+    // Scaling the model up by k takes k times the thickness (`--size` comes before
+    // `--scale`).
+    let size = mesh.longest_side() * thickness / fits / scale;
+    SchemeError::Options(format!(
+        "--thickness {}mm is too thick for this model at this size: {what}; --thickness {}mm fits, or --size {}mm takes it",
+        fmt_num(thickness),
+        fmt_num((fits * 1e3).floor() / 1e3),
+        (size * 1.001).ceil()
+    ))
+}
