@@ -147,6 +147,19 @@ fn the_map_of_genus3_names_its_faces_where_they_are_seen() {
     check_map(&model("genus3"), "half-edge", "300mm", None, &[]);
 }
 
+#[test]
+fn a_sheet_forty_metres_across_gets_its_map() {
+    // Its views get coarser raster cells rather than buffers of gigabytes (the build
+    // had aborted on allocation).
+    check_map(
+        &model("genus3"),
+        "half-edge",
+        "300mm",
+        None,
+        &["--sheet", "40000x40000mm"],
+    );
+}
+
 /// The README's bunny (quad-edge, 4 ft, 625 edges) with `args`, checked by `test`.
 fn check_thesis_bunny(test: &str, args: &[&str]) {
     if let Some(shared) = shared_models(test) {

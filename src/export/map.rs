@@ -89,6 +89,10 @@ pub(super) fn views() -> [View; 6] {
 /// Raster cells per millimetre of paper for the owner buffers.
 const RASTER_PER_MM: f64 = 4.0;
 
+/// Most raster cells of one view: a page metres across gets coarser cells rather than
+/// buffers of gigabytes.
+const RASTER_MAX_CELLS: f64 = 4.0e6;
+
 /// Id text heights on paper (mm): large enough to read printed, small enough that
 /// neighbouring panels' ids fit.
 const TEXT_MIN: f64 = 1.8;
@@ -931,16 +935,21 @@ fn vec3(v: DVec3) -> String {
 /// A view's owner buffer: which panel is seen at each raster cell of its page cell.
 struct Raster {
     lo: DVec2,
+    /// Cells per millimetre of paper.
+    per_mm: f64,
     width: usize,
     height: usize,
 }
 
 impl Raster {
     fn new(lo: DVec2, size: DVec2) -> Raster {
+        let area = (size.x * size.y).max(1e-9);
+        let per_mm = RASTER_PER_MM.min((RASTER_MAX_CELLS / area).sqrt());
         Raster {
             lo,
-            width: (size.x * RASTER_PER_MM).ceil().max(1.0) as usize,
-            height: (size.y * RASTER_PER_MM).ceil().max(1.0) as usize,
+            per_mm,
+            width: (size.x * per_mm).ceil().max(1.0) as usize,
+            height: (size.y * per_mm).ceil().max(1.0) as usize,
         }
     }
 
@@ -961,7 +970,7 @@ impl Raster {
             let pts: Vec<(DVec2, f64)> = patch
                 .points
                 .iter()
-                .map(|&p| ((to_page(p) - self.lo) * RASTER_PER_MM, p.dot(view.toward)))
+                .map(|&p| ((to_page(p) - self.lo) * self.per_mm, p.dot(view.toward)))
                 .collect();
             for k in 1..pts.len().saturating_sub(1) {
                 self.triangle([pts[0], pts[k], pts[k + 1]], id, &mut owner, &mut depth);
@@ -1008,7 +1017,7 @@ impl Raster {
     /// The panel seen at a page point and all round it (the raster cell there and its
     /// eight neighbours), so an id's centre is never at the edge of what is seen.
     fn owner_at(&self, owners: &[Option<u32>], at: DVec2) -> Option<u32> {
-        let q = (at - self.lo) * RASTER_PER_MM;
+        let q = (at - self.lo) * self.per_mm;
         if q.x < 1.0 || q.y < 1.0 {
             return None;
         }
