@@ -57,7 +57,13 @@ pub fn flat_regions(mesh: &Mesh, rules: &RegionRules<'_>) -> Result<FlatRegions,
 fn grow_regions(mesh: &Mesh, rules: &RegionRules<'_>) -> Vec<u32> {
     let mut growth = Growth {
         region: vec![u32::MAX; mesh.face_count()],
-        touched: vec![u32::MAX; mesh.vertex_count()],
+        touched: vec![
+            u32::MAX;
+            mesh.vertices()
+                .map(|v| mesh.vertex_source(v) as usize + 1)
+                .max()
+                .unwrap_or(0)
+        ],
         queue: VecDeque::new(),
     };
     let mut count = 0u32;
@@ -95,7 +101,8 @@ fn grow_regions(mesh: &Mesh, rules: &RegionRules<'_>) -> Vec<u32> {
 struct Growth {
     /// Each face's region, or `u32::MAX`.
     region: Vec<u32>,
-    /// The last region touching each vertex.
+    /// The last region touching each input vertex: the copies of a vertex split where
+    /// two fans met at it are one point, where a region must not touch itself either.
     touched: Vec<u32>,
     /// Faces to try next.
     queue: VecDeque<FaceId>,
@@ -106,7 +113,7 @@ impl Growth {
     fn join(&mut self, mesh: &Mesh, f: FaceId, k: u32) {
         self.region[f.index()] = k;
         for v in mesh.face_vertices(f) {
-            self.touched[v.index()] = k;
+            self.touched[mesh.vertex_source(v) as usize] = k;
         }
         for h in mesh.face_half_edges(f) {
             if let Some(g) = mesh.face(h.twin()) {
@@ -137,7 +144,8 @@ impl Growth {
         // the region, or the region would pinch there.
         (0..n).all(|i| {
             let before = (i + n - 1) % n;
-            shared[i] || shared[before] || self.touched[mesh.origin(sides[i]).index()] != k
+            let v = mesh.origin(sides[i]);
+            shared[i] || shared[before] || self.touched[mesh.vertex_source(v) as usize] != k
         })
     }
 }
@@ -243,18 +251,69 @@ fn straight_corners(
                 && (p - a).reject_from(along).length() <= tolerance
         })
         .collect();
-    for lp in loops {
-        let kept = lp
-            .iter()
-            .filter(|&&h| !dropped[mesh.origin(h).index()])
-            .count();
-        if kept < 3 {
-            for &h in lp {
-                dropped[mesh.origin(h).index()] = false;
+    // Each run of dropped corners must lie within `tolerance` of the chord that
+    // replaces it (small turns add up along a finely cut curve), and every region
+    // keeps three corners; keeping a corner shortens chords, so until both hold.
+    let mut changed = true;
+    while changed {
+        changed = false;
+        for lp in loops {
+            let corners: Vec<VertexId> = lp.iter().map(|&h| mesh.origin(h)).collect();
+            let kept = corners.iter().filter(|v| !dropped[v.index()]).count();
+            if kept < 3 {
+                // A third of the way round each: the chords refine from there.
+                let n = corners.len();
+                for v in [corners[0], corners[n / 3], corners[2 * n / 3]] {
+                    changed |= std::mem::replace(&mut dropped[v.index()], false);
+                }
+                continue;
+            }
+            if let Some(v) = farthest_off_chord(mesh, &corners, &dropped, tolerance) {
+                dropped[v.index()] = false;
+                changed = true;
             }
         }
     }
     dropped
+}
+
+/// The dropped corner of an outline farthest from the chord between the kept corners
+/// round it, when that is more than `tolerance`.
+fn farthest_off_chord(
+    mesh: &Mesh,
+    corners: &[VertexId],
+    dropped: &[bool],
+    tolerance: f64,
+) -> Option<VertexId> {
+    let n = corners.len();
+    let first = (0..n).find(|&i| !dropped[corners[i].index()])?;
+    let mut worst: Option<(f64, VertexId)> = None;
+    let mut from = first;
+    for step in 1..=n {
+        let i = (first + step) % n;
+        if dropped[corners[i].index()] {
+            continue;
+        }
+        let (a, b) = (mesh.position(corners[from]), mesh.position(corners[i]));
+        let mut k = (from + 1) % n;
+        while k != i {
+            let p = mesh.position(corners[k]);
+            let off = distance_to_segment(p, a, b);
+            if off > tolerance && worst.is_none_or(|(d, _)| off > d) {
+                worst = Some((off, corners[k]));
+            }
+            k = (k + 1) % n;
+        }
+        from = i;
+    }
+    worst.map(|(_, v)| v)
+}
+
+/// How far `p` lies from the segment `a`–`b`.
+fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    (a + t * ab).distance(p)
 }
 
 /// The mesh of the regions' outlines less the dropped corners, and each new edge's
@@ -462,6 +521,35 @@ mod tests {
             .map(|f| regions.mesh.face_area(f))
             .sum();
         assert!((area - 8.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_finely_cut_round_border_keeps_its_corners() {
+        // A flat fan disc of 2000 border points: each bends its border by far less
+        // than the tolerance, but together they are a circle, not a chord.
+        let n = 2000;
+        let mut p = vec![DVec3::ZERO];
+        p.extend((0..n).map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            DVec3::new(100.0 * a.cos(), 100.0 * a.sin(), 0.0)
+        }));
+        let tris: Vec<[u32; 3]> = (0..n).map(|k| [0, 1 + k, 1 + (k + 1) % n]).collect();
+        let disc = build_from_faces(p, &tris).unwrap();
+        let rules = RegionRules {
+            tolerance: 0.005,
+            max_faces: usize::MAX,
+            fits: &|p| Some(p.to_vec()),
+        };
+        let regions = flat_regions(&disc, &rules).unwrap();
+        assert_eq!(regions.faces.len(), 1);
+        let exact: f64 = disc.faces().map(|f| disc.face_area(f)).sum();
+        let merged = regions.mesh.face_area(FaceId(0));
+        // Within the tolerance along the whole border, and fewer corners than given.
+        assert!(
+            exact - merged < 0.005 * 2.0 * std::f64::consts::PI * 100.0,
+            "{merged} of {exact}"
+        );
+        assert!(regions.mesh.face_degree(FaceId(0)) < n as usize);
     }
 
     #[test]

@@ -1052,8 +1052,9 @@ fn rigid_panels(mesh: &Mesh, options: &NetOptions) -> Result<SchemeOutput, Schem
                 covers: Covers::Faces(k),
             })
             .collect(),
-        anchors: anchors.clone(),
+        anchors: anchors.iter().copied().map(Some).collect(),
         edge_numbers: regions.edge_source.clone(),
+        noun: "island",
     };
     let mut output = rigid_output(&regions.mesh, mesh, &options.rigid, &options.panel, &names)?;
     let mut sizes: Vec<usize> = regions.faces.iter().map(Vec::len).collect();

@@ -592,10 +592,19 @@ impl CornerFrame {
 
     /// The part of `outline` near this corner.
     fn near(&self, outline: &FlatOutline) -> FlatOutline {
+        if is_convex(&outline.points) {
+            return clip_outline(outline, self.at + self.reach * self.inward, -self.inward);
+        }
         let side = |p: DVec2| (p - self.at).dot(self.inward) - self.reach;
+        if outline.points.iter().all(|&p| side(p) <= 0.0) {
+            return outline.clone();
+        }
         match side_run(outline, self.at, |p| side(p) <= 0.0) {
             Some((from, to)) => keep_between(outline, from, to, side),
-            None => outline.clone(),
+            None => FlatOutline {
+                points: Vec::new(),
+                along: Vec::new(),
+            },
         }
     }
 }
@@ -610,15 +619,19 @@ fn cut_corner(
     outline: &FlatOutline,
     r: f64,
 ) -> Option<FlatOutline> {
-    let side = |p: DVec2| (p - corner.at).dot(corner.inward) - r;
-    let cut = match side_run(outline, corner.at, |p| side(p) < 0.0) {
+    let cut = if is_convex(&outline.points) {
+        clip_outline(outline, corner.at + r * corner.inward, corner.inward)
+    } else {
         // The corner's own points inside the cut go; the rest of the outline stays,
         // however far round it comes back (a region's outline need not be convex).
-        Some((from, to)) => {
-            let m = outline.points.len();
-            keep_between(outline, (to + 1) % m, (from + m - 1) % m, side)
+        let side = |p: DVec2| (p - corner.at).dot(corner.inward) - r;
+        match side_run(outline, corner.at, |p| side(p) < 0.0) {
+            Some((from, to)) => {
+                let m = outline.points.len();
+                keep_between(outline, (to + 1) % m, (from + m - 1) % m, side)
+            }
+            None => outline.clone(),
         }
-        None => outline.clone(),
     };
     let sides_kept = outline
         .along
@@ -638,6 +651,33 @@ fn cut_corner(
         && cut.points.len() >= 3
         && outline_is_sound(&cut, &sides, &dir))
     .then_some(cut)
+}
+
+/// The part of an outline where `(p - at)·inward >= 0`, the cut a side of its own.
+fn clip_outline(outline: &FlatOutline, at: DVec2, inward: DVec2) -> FlatOutline {
+    let m = outline.points.len();
+    let side = |p: DVec2| (p - at).dot(inward);
+    let mut clipped = FlatOutline {
+        points: Vec::with_capacity(m + 1),
+        along: Vec::with_capacity(m + 1),
+    };
+    for i in 0..m {
+        let (p, q) = (outline.points[i], outline.points[(i + 1) % m]);
+        let (sp, sq) = (side(p), side(q));
+        if sp >= 0.0 {
+            clipped.points.push(p);
+            clipped.along.push(outline.along[i]);
+        }
+        if (sp >= 0.0) != (sq >= 0.0) {
+            let crossing = p + (q - p) * (sp / (sp - sq));
+            clipped.points.push(crossing);
+            // Leaving the kept part, the cut runs on to where the outline comes back.
+            clipped
+                .along
+                .push(if sp >= 0.0 { None } else { outline.along[i] });
+        }
+    }
+    clipped
 }
 
 /// The run of outline points, from the one nearest `vertex` on both ways round, for

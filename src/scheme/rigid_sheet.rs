@@ -137,10 +137,13 @@ impl RigidSheet {
 pub(super) struct PanelNames {
     /// Each face's panel.
     pub sources: Vec<Source>,
-    /// Where each face's panel id goes (a point inside the face).
-    pub anchors: Vec<DVec3>,
+    /// Where each face's panel id goes (a point inside the face), or `None` for the
+    /// middle of its cut-back outline's corners.
+    pub anchors: Vec<Option<DVec3>>,
     /// Each edge's number in the user's model (brackets and notes name it).
     pub edge_numbers: Vec<u32>,
+    /// What a panel is called in messages ("face", "island").
+    pub noun: &'static str,
 }
 
 impl PanelNames {
@@ -148,8 +151,9 @@ impl PanelNames {
     pub(super) fn of_faces(mesh: &Mesh) -> PanelNames {
         PanelNames {
             sources: mesh.faces().map(|f| Source::face(f.0)).collect(),
-            anchors: mesh.faces().map(|f| mesh.face_centre(f)).collect(),
+            anchors: vec![None; mesh.face_count()],
             edge_numbers: mesh.edges().map(|e| e.0).collect(),
+            noun: "face",
         }
     }
 
@@ -188,9 +192,10 @@ pub(super) fn rigid_output(
             .iter()
             .enumerate()
             .filter_map(|(k, h)| Some((k, names.id(mesh.face((*h)?.twin())?))));
+        let middle = || outline.points.iter().copied().sum::<DVec3>() / outline.points.len() as f64;
         let labels = outline_labels(
             names.sources[f].id,
-            names.anchors[f],
+            names.anchors[f].unwrap_or_else(middle),
             &outline.points,
             partners,
             panel.label_height,
@@ -271,7 +276,8 @@ fn too_thick(
 ) -> SchemeError {
     let what = match error {
         RigidError::NoRoom { face } => format!(
-            "{} has no panel left once cut back from its edges and corners",
+            "{} {} has no panel left once cut back from its edges and corners",
+            names.noun,
             names.id(*face)
         ),
         RigidError::SticksOut { face, depth } => format!(
