@@ -550,20 +550,38 @@ fn the_net_in_3mm_sheet_makes_one_part_per_flat_region() {
 fn the_rigid_net_refuses_what_only_folds_need_and_names_islands() {
     let tmp = TempDir::new().unwrap();
     let cube = model("hexahedron");
+    // 200 mm unless a case says otherwise; 25 mm on a 40 mm cube is too thick.
     for (extra, says) in [
         (
-            vec!["--thickness", "3mm", "--island-spread", "2"],
+            vec![
+                "--size",
+                "200mm",
+                "--thickness",
+                "3mm",
+                "--island-spread",
+                "2",
+            ],
             "--island-spread",
         ),
-        (vec!["--connectors", "none"], "--connectors none"),
         (
-            vec!["--thickness", "3mm", "--connectors", "tab"],
+            vec!["--size", "200mm", "--connectors", "none"],
+            "--connectors none",
+        ),
+        (
+            vec![
+                "--size",
+                "200mm",
+                "--thickness",
+                "3mm",
+                "--connectors",
+                "tab",
+            ],
             "--connectors tab",
         ),
-        (vec!["--thickness", "25mm", "--size", "40mm"], "N"),
+        (vec!["--size", "40mm", "--thickness", "25mm"], "N"),
     ] {
         let out = tmp.path().join("out");
-        let mut args = vec![cube.to_str().unwrap(), "--scheme", "net", "--size", "200mm"];
+        let mut args = vec![cube.to_str().unwrap(), "--scheme", "net"];
         args.extend(extra);
         args.extend(["--build-anyway", "--out", out.to_str().unwrap()]);
         let run = unfold(args);

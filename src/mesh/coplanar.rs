@@ -298,7 +298,7 @@ fn farthest_off_chord(
         let mut k = (from + 1) % n;
         while k != i {
             let p = mesh.position(corners[k]);
-            let off = distance_to_segment(p, a, b);
+            let off = super::distance::segment_distance(p, a, b);
             if off > tolerance && worst.is_none_or(|(d, _)| off > d) {
                 worst = Some((off, corners[k]));
             }
@@ -307,13 +307,6 @@ fn farthest_off_chord(
         from = i;
     }
     worst.map(|(_, v)| v)
-}
-
-/// How far `p` lies from the segment `a`–`b`.
-fn distance_to_segment(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
-    (a + t * ab).distance(p)
 }
 
 /// The mesh of the regions' outlines less the dropped corners, and each new edge's

@@ -47,6 +47,17 @@ pub fn closest_point_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> DVec
     a + ab * v + ac * w
 }
 
+/// The distance from `p` to the segment `a`–`b`.
+pub fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let ab = b - a;
+    let t = if ab.length_squared() > 0.0 {
+        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + t * ab)
+}
+
 /// The distance from `p` to the nearest point of the box `lo..hi`: no point of a
 /// triangle in the box lies nearer, so a search skips the triangle when this is
 /// beyond the nearest distance found.

@@ -620,7 +620,7 @@ mod tests {
             },
             tabs: true,
             tab_height,
-            rigid: super::super::rigid_sheet::RigidSheet::CARD,
+            rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
         }
     }
 

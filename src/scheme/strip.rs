@@ -22,7 +22,7 @@ use super::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
 use super::net::{islands_along, FlatFoldArgs, IslandNames, NetOptions, OwnNet, FLAT_FOLD_DEG};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{Scheme, SchemeError, SchemeOutput};
-use crate::mesh::distance::TriangleGrid;
+use crate::mesh::distance::{segment_distance, TriangleGrid};
 use crate::mesh::soup::{find, union};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
@@ -571,17 +571,6 @@ fn keep_within(p: &[DVec3], from: usize, to: usize, tolerance: f64, keep: &mut [
             }
         }
     }
-}
-
-/// The distance from `p` to the segment `a`–`b`.
-fn segment_distance(p: DVec3, a: DVec3, b: DVec3) -> f64 {
-    let ab = b - a;
-    let t = if ab.length_squared() > 0.0 {
-        ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    p.distance(a + t * ab)
 }
 
 /// A band of triangles between two curves, each triangle sharing a rung (an edge from
