@@ -6,12 +6,17 @@
 //! the model (`two_pole_field`); between two neighbouring curves, the band of
 //! triangles that bends least (every corner on one of the two curves, so no vertex is
 //! inside the band and it unrolls exactly; the dynamic programme of the strip paper,
-//! `003`). Bands whose strips stray from the model further than `--max-deviation`,
-//! measured both ways, are split by curves between (`strips_within`). The strips are
-//! welded into one surface where they share their curves' points; the net scheme's
-//! islands then grow along each strip's rungs in order, so a piece is a run of its
-//! strip, as long as keeps it clear of itself and on the sheet, and every curve
-//! between strips (and the rung between two pieces) gets a tab with match numbers.
+//! `003`). A band whose strip strays from the model further than `--max-deviation`,
+//! measured both ways, is cut across into sectors about as long as the sheet (along
+//! the field's rise, from one curve to the other), and each sector is covered from its
+//! lower curve up by bands as wide as keep their strips within, so that a sharp part
+//! of a ring (an ear) does not narrow the strips round the rest (`strips_within`).
+//! Where a sector meets one split differently, each point of one on the other's edge
+//! becomes a corner of both. The strips are welded into one surface where they share
+//! their curves' points; the net scheme's islands then grow along each strip's rungs
+//! in order, so a piece is a run of its strip, as long as keeps it clear of itself
+//! and on the sheet, and every curve between strips (and the rung between two
+//! pieces) gets a tab with match numbers.
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -250,7 +255,13 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
         &surface,
         &two_pole_field(&surface).map_err(SchemeError::Model)?,
     );
-    let banded = strips_within(&surface, &field, tolerance).map_err(|e| {
+    // Bands are cut across into sectors no longer than the sheet's longer side.
+    let sector_length = options
+        .net
+        .panel
+        .panel_limit
+        .map_or(f64::INFINITY, |limit| limit.width.max(limit.height));
+    let banded = strips_within(&surface, &field, tolerance, sector_length).map_err(|e| {
         SchemeError::Model(format!(
             "no strips within {tolerance:.3} mm of the model: {e}; a larger --max-deviation may reach"
         ))
@@ -582,6 +593,10 @@ pub struct Strip {
     pub triangles: Vec<[u32; 3]>,
 }
 
+/// What a triangle facing away from the surface costs, in radians of bending: more
+/// than any band bends.
+const FOLD_COST: f64 = 1e4;
+
 /// How much a rung's length counts against a radian of bending, per band width: the
 /// rungs go across the band, not along it (in a narrow band a triangle's normal says
 /// little about the surface, and bending alone would fan far along it), and among
@@ -594,6 +609,14 @@ const RUNG_WEIGHT: f64 = 0.25;
 /// advance along one curve or the other, the cost of each the angle between its
 /// normal and the previous triangle's.
 pub fn band(p: &[DVec3], q: &[DVec3]) -> Strip {
+    band_facing(p, q, None)
+}
+
+/// [`band`], with no triangle facing away from the surface where `facing` gives the
+/// surface's normal at each point (of `p`, then of `q`): a band between curves that
+/// bend (a sector's cut edges) could otherwise fold a triangle over a concave corner,
+/// onto its neighbour. Where no band keeps to that, the one with fewest such.
+fn band_facing(p: &[DVec3], q: &[DVec3], facing: Option<&[DVec3]>) -> Strip {
     let (n, m) = (p.len(), q.len());
     let points: Vec<DVec3> = p.iter().chain(q).copied().collect();
     if n == 0 || m == 0 || n + m < 3 {
@@ -617,6 +640,7 @@ pub fn band(p: &[DVec3], q: &[DVec3]) -> Strip {
         points: &points,
         n,
         m,
+        facing,
     };
     let cost = rungs.costs();
     let triangles = rungs.trace_back(&cost);
@@ -632,6 +656,8 @@ struct Rungs<'a> {
     m: usize,
     /// The band's mean width, the unit of rung length.
     width: f64,
+    /// The surface's normal at each point, if no triangle may face away from it.
+    facing: Option<&'a [DVec3]>,
 }
 
 impl Rungs<'_> {
@@ -651,6 +677,12 @@ impl Rungs<'_> {
             0 => i.checked_sub(1).map(|i| (i, j)),
             _ => j.checked_sub(1).map(|j| (i, j)),
         }
+    }
+
+    /// Whether triangle `t` faces away from the surface at its corners.
+    fn faces_away(&self, t: [usize; 3]) -> bool {
+        self.facing
+            .is_some_and(|normals| self.normal(t).dot(t.map(|i| normals[i]).iter().sum()) < 0.0)
     }
 
     fn normal(&self, t: [usize; 3]) -> DVec3 {
@@ -702,11 +734,15 @@ impl Rungs<'_> {
                         continue;
                     };
                     let next = self.triangle(i, j, k);
+                    let fold = match self.faces_away(next) {
+                        true => FOLD_COST,
+                        false => 0.0,
+                    };
                     let best = (0..2)
                         .filter(|&h| cost[from.0 * m + from.1][h].is_finite())
                         .map(|h| self.through(&cost, from, h, next))
                         .fold(f64::INFINITY, f64::min);
-                    cost[i * m + j][k] = best + RUNG_WEIGHT * length / self.width;
+                    cost[i * m + j][k] = best + fold + RUNG_WEIGHT * length / self.width;
                 }
             }
         }
@@ -744,20 +780,33 @@ impl Rungs<'_> {
 /// cut open at the rung from `p`'s first point to the nearest point of `q`, which
 /// then starts and ends both curves.
 pub fn ring(p: &[DVec3], q: &[DVec3]) -> Strip {
+    ring_facing(p, q, None)
+}
+
+/// [`ring`], with the surface's normal at each point of `p` and `q` as
+/// [`band_facing`] takes them.
+fn ring_facing(p: &[DVec3], q: &[DVec3], normals: Option<(&[DVec3], &[DVec3])>) -> Strip {
     let Some(first) = p.first() else {
         return band(p, q);
     };
     let start = (0..q.len())
         .min_by(|&a, &b| q[a].distance(*first).total_cmp(&q[b].distance(*first)))
         .unwrap_or(0);
-    let open_p: Vec<DVec3> = p.iter().chain([first]).copied().collect();
-    let open_q: Vec<DVec3> = q[start..]
-        .iter()
-        .chain(&q[..start])
-        .chain(q.get(start))
-        .copied()
-        .collect();
-    band(&open_p, &open_q)
+    // Both loops opened and closed again: `p` from its first point, `q` from `start`.
+    let open = |p: &[DVec3], start: usize| -> Vec<DVec3> {
+        p[start..]
+            .iter()
+            .chain(&p[..start])
+            .chain(p.get(start))
+            .copied()
+            .collect()
+    };
+    let facing = normals.map(|(np, nq)| {
+        let mut both = open(np, 0);
+        both.extend(open(nq, start));
+        both
+    });
+    band_facing(&open(p, 0), &open(q, start), facing.as_deref())
 }
 
 /// The strip laid flat: a point per corner, each triangle placed against the rung it
@@ -929,6 +978,9 @@ pub struct Slices {
     values: Vec<f64>,
     /// Each piece: its band and its corners (indices into `points`), counter-clockwise.
     pieces: Vec<(usize, Vec<u32>)>,
+    /// The field's values the first and last levels stand for, where the surface is a
+    /// patch whose outline lies on them (its corners there are on those levels).
+    held: Option<[f64; 2]>,
 }
 
 /// A region of one band: the pieces of the band joined across their shared edges.
@@ -948,12 +1000,24 @@ impl Slices {
     /// `surface` cut along `levels` (increasing, none equal to a value of `field` at a
     /// corner, so every cut crosses edges between their ends).
     pub fn new(surface: &Triangles, field: &[f64], levels: Vec<f64>) -> Slices {
+        Slices::held(surface, field, levels, None)
+    }
+
+    /// [`Slices::new`] of a patch whose corners at the values `held` (below the
+    /// second level and above the last but one) lie on the first and last levels.
+    fn held(
+        surface: &Triangles,
+        field: &[f64],
+        levels: Vec<f64>,
+        held: Option<[f64; 2]>,
+    ) -> Slices {
         let mut slices = Slices {
             levels,
             points: Vec::new(),
             origins: Vec::new(),
             values: Vec::new(),
             pieces: Vec::new(),
+            held,
         };
         let mut ids: BTreeMap<Origin, u32> = BTreeMap::new();
         for corners in &surface.corners {
@@ -1015,8 +1079,21 @@ impl Slices {
     pub fn level_of(&self, id: u32) -> Option<usize> {
         match self.origins[id as usize] {
             Origin::Crossing { level, .. } => Some(level as usize),
-            Origin::Corner(_) => None,
+            Origin::Corner(_) => {
+                let [below, above] = self.held?;
+                let value = self.values[id as usize];
+                match (value == below, value == above) {
+                    (true, _) => Some(0),
+                    (_, true) => Some(self.levels.len() - 1),
+                    _ => None,
+                }
+            }
         }
+    }
+
+    /// Whether point `id` is where a level crosses an edge of the surface.
+    fn is_crossing(&self, id: u32) -> bool {
+        matches!(self.origins[id as usize], Origin::Crossing { .. })
     }
 
     /// The regions: per band, its pieces joined across shared edges, in band order
@@ -1076,16 +1153,25 @@ impl Slices {
     /// curves the fewest points within `tolerance` of them ([`simplify`]), the same
     /// for the regions on either side of the curve.
     pub fn kept(&self, tolerance: f64) -> Vec<bool> {
+        self.kept_with(tolerance, &|_| true)
+    }
+
+    /// [`Slices::kept`], keeping of the surface's corners those `corner_kept` says.
+    fn kept_with(&self, tolerance: f64, corner_kept: &dyn Fn(u32) -> bool) -> Vec<bool> {
         let mut keep: Vec<bool> = self
             .origins
             .iter()
-            .map(|o| matches!(o, Origin::Corner(_)))
+            .map(|o| match *o {
+                Origin::Corner(v) => corner_kept(v),
+                Origin::Crossing { .. } => false,
+            })
             .collect();
         // Each level's curves, from the edges of the pieces above it that lie on it.
         let mut next: BTreeMap<u32, u32> = BTreeMap::new();
         for (band, corners) in &self.pieces {
             for (a, b) in cycle_pairs(corners) {
-                if self.level_of(a) == Some(*band) && self.level_of(b) == Some(*band) {
+                let on = |i: u32| self.is_crossing(i) && self.level_of(i) == Some(*band);
+                if on(a) && on(b) {
                     next.insert(a, b);
                 }
             }
@@ -1097,6 +1183,35 @@ impl Slices {
             }
         }
         keep
+    }
+
+    /// `region` as a patch of its own: its pieces fanned into triangles, keeping the
+    /// points `kept`, between its band's levels (or the values they stand for).
+    fn patch(&self, region: &Region, kept: &[bool]) -> Patch {
+        let fans: Vec<[u32; 3]> = region
+            .pieces
+            .iter()
+            .flat_map(|&k| {
+                let c = &self.pieces[k].1;
+                (1..c.len() - 1).map(move |i| [c[0], c[i], c[i + 1]])
+            })
+            .collect();
+        let (ids, corners) = renumbered(&fans);
+        let last = self.levels.len() - 1;
+        let end = |level: usize| match (self.held, level) {
+            (Some(held), 0) => held[0],
+            (Some(held), l) if l == last => held[1],
+            _ => self.levels[level],
+        };
+        Patch {
+            surface: Triangles {
+                points: ids.iter().map(|&i| self.point(i)).collect(),
+                corners,
+            },
+            values: ids.iter().map(|&i| self.values[i as usize]).collect(),
+            kept: ids.iter().map(|&i| kept[i as usize]).collect(),
+            ends: [end(region.band), end(region.band + 1)],
+        }
     }
 
     /// The strip of `region`, its corners the points `kept`: between its two loops
@@ -1155,11 +1270,54 @@ impl Slices {
             // loops of each level joined into one through the region, and the band
             // between the two.
             let below = self.bridged(region, &lower, kept).ok_or_else(unjoined)?;
-            let above = self.bridged(region, &upper, kept).ok_or_else(unjoined)?;
-            return Ok(ring(&positions(&below), &positions_reversed(self, &above)));
+            let mut above = self.bridged(region, &upper, kept).ok_or_else(unjoined)?;
+            above.reverse();
+            let normals = self.normals(region);
+            let facing = |ids: &[u32]| ids.iter().map(|i| normals[i]).collect::<Vec<_>>();
+            let facing = (facing(&below), facing(&above));
+            let strip = ring_facing(
+                &positions(&below),
+                &positions(&above),
+                Some((&facing.0, &facing.1)),
+            );
+            return Ok(strip);
         }
         let one = self.bridged(region, &loops, kept).ok_or_else(unjoined)?;
-        Ok(self.disk_strip(&one, region.band))
+        Ok(self.disk_strip(&one, region.band, &self.normals(region)))
+    }
+
+    /// Whether a triangle of `strip` (of `region`) faces away from the surface.
+    fn folds(&self, region: &Region, strip: &Strip) -> bool {
+        let normals = self.normals(region);
+        let by_position: HashMap<[u64; 3], DVec3> = normals
+            .iter()
+            .map(|(&i, &n)| (self.point(i).to_array().map(f64::to_bits), n))
+            .collect();
+        let normal = |p: DVec3| by_position.get(&p.to_array().map(f64::to_bits)).copied();
+        strip.triangles.iter().any(|t| {
+            let [a, b, c] = t.map(|i| strip.points[i as usize]);
+            let sum: Option<DVec3> = [a, b, c].into_iter().map(normal).sum();
+            sum.is_some_and(|n| (b - a).cross(c - a).dot(n) < 0.0)
+        })
+    }
+
+    /// The surface's normal at each corner of `region`'s pieces: the sum of its
+    /// pieces' normals there, each as long as twice the piece's area.
+    fn normals(&self, region: &Region) -> BTreeMap<u32, DVec3> {
+        let mut normals: BTreeMap<u32, DVec3> = BTreeMap::new();
+        for &k in &region.pieces {
+            let c = &self.pieces[k].1;
+            let normal: DVec3 = (1..c.len() - 1)
+                .map(|i| {
+                    let [a, b, d] = [c[0], c[i], c[i + 1]].map(|v| self.point(v));
+                    (b - a).cross(d - a)
+                })
+                .sum();
+            for &v in c {
+                *normals.entry(v).or_insert(DVec3::ZERO) += normal;
+            }
+        }
+        normals
     }
 
     /// The loops of `region` joined into one by bridges (the region then a disk, its
@@ -1220,7 +1378,7 @@ impl Slices {
     /// The strip of a region bounded by one loop (region on its left): from the ends of
     /// the loop's longest run on the lower level (or, on a loop with none or all of
     /// it, from its first point to the point halfway round), one side against the other.
-    fn disk_strip(&self, ring_ids: &[u32], lower: usize) -> Strip {
+    fn disk_strip(&self, ring_ids: &[u32], lower: usize, normals: &BTreeMap<u32, DVec3>) -> Strip {
         let n = ring_ids.len();
         let low = |k: usize| self.level_of(ring_ids[k % n]) == Some(lower);
         // The longest cyclic run of lower-level points: its start and length.
@@ -1236,158 +1394,740 @@ impl Slices {
         } else {
             (0, n / 2)
         };
-        let p: Vec<DVec3> = (start..=end).map(|k| self.point(ring_ids[k % n])).collect();
+        let p: Vec<u32> = (start..=end).map(|k| ring_ids[k % n]).collect();
         // The other side, from before `start` back round to after `end`.
-        let q: Vec<DVec3> = (1..n - (end - start))
-            .map(|d| self.point(ring_ids[(start + n - d) % n]))
+        let q: Vec<u32> = (1..n - (end - start))
+            .map(|d| ring_ids[(start + n - d) % n])
             .collect();
-        band(&p, &q)
+        let facing: Vec<DVec3> = p.iter().chain(&q).map(|i| normals[i]).collect();
+        let at = |ids: &[u32]| ids.iter().map(|&i| self.point(i)).collect::<Vec<_>>();
+        band_facing(&at(&p), &at(&q), Some(&facing))
     }
 }
 
-/// Strips covering a surface, each band of the field's levels within the distance
-/// asked of the surface both ways.
+/// Strips covering a surface, each within the distance asked of the part of the
+/// surface it covers, both ways.
 pub struct Banded {
-    pub slices: Slices,
-    pub regions: Vec<Region>,
-    /// A strip per region, in the regions' order.
+    /// The strips, their outlines meeting point for point.
     pub strips: Vec<Strip>,
-    /// The largest distance measured between a strip and its region, either way.
+    /// The largest distance measured between a strip and the part it covers, either way.
     pub deviation: f64,
 }
 
-/// How many times the bands are split before the bound is given up on.
-const MOST_ROUNDS: usize = 40;
+/// How many bands are tried for each band grown.
+const MOST_TRIES: usize = 12;
 
-/// The strips of `surface` between levels of `field`, from one band over the whole
-/// field, each band whose strips stray more than `tolerance` from its regions (either
-/// way, measured at points `tolerance / 3` apart, allowing for the points between)
-/// split into equal bands, as many as should bring it within, until none strays.
-pub fn strips_within(surface: &Triangles, field: &[f64], tolerance: f64) -> Result<Banded, String> {
-    let mut values: Vec<f64> = field.to_vec();
-    values.sort_by(f64::total_cmp);
-    let (Some(&lo), Some(&hi)) = (values.first(), values.last()) else {
-        return Err("the surface has no points".into());
-    };
-    let span = (hi - lo).max(1e-9);
-    let mut levels = vec![lo - 1e-3 * span, hi + 1e-3 * span];
-    let spacing = tolerance / 3.0;
-    // Every point of a triangle lies within spacing/√3 of a sample.
-    let within = tolerance - spacing / 3f64.sqrt();
-    // Bands measured in earlier rounds (by their levels' bits): unchanged since.
-    let mut measured: BTreeMap<(u64, u64), f64> = BTreeMap::new();
-    for _ in 0..MOST_ROUNDS {
-        let slices = Slices::new(surface, field, levels.clone());
-        let kept = slices.kept(0.5 * tolerance);
-        let regions = slices.regions();
-        let round = measure(&slices, &regions, &kept, &measured, spacing);
-        let mut worst = round.worst;
-        for (b, d) in worst.iter_mut().enumerate() {
-            let key = (levels[b].to_bits(), levels[b + 1].to_bits());
-            *d = d.max(*measured.entry(key).or_insert(*d));
-        }
-        let wide: Vec<usize> = (0..worst.len()).filter(|&b| worst[b] > within).collect();
-        if wide.is_empty() {
-            let deviation = worst.iter().copied().fold(0.0, f64::max);
-            return Ok(Banded {
-                slices,
-                regions,
-                strips: round.strips,
-                deviation,
-            });
-        }
-        for &b in wide.iter().rev() {
-            let (below, above) = (levels[b], levels[b + 1]);
-            if above - below < 1e-6 * span {
-                return Err(match worst[b].is_finite() {
-                    true => format!(
-                        "a band of the field {below}..{above} stays {:.3} mm from the surface",
-                        worst[b]
-                    ),
-                    false => round.why[b].clone(),
-                });
-            }
-            // A band's distance grows about as its width squared: split it into as
-            // many as should bring it within.
-            let parts = match worst[b].is_finite() {
-                true => ((worst[b] / within).sqrt().ceil() as usize).clamp(2, 8),
-                false => 4,
-            };
-            for k in (1..parts).rev() {
-                let t = k as f64 / parts as f64;
-                levels.insert(b + 1, off_values(below + t * (above - below), &values));
-            }
-        }
-    }
-    Err(format!(
-        "{MOST_ROUNDS} rounds of splitting bands did not reach {tolerance} mm"
-    ))
-}
+/// How many times a part of the surface is split before the bound is given up on.
+const MOST_SPLITS: usize = 40;
 
-/// One round of [`strips_within`]: a strip per region and, per band, the largest
-/// distance between its strips and regions (none measured for a band in `measured`;
-/// infinite, with the reason, where a region has no strip).
-struct Round {
-    strips: Vec<Strip>,
-    worst: Vec<f64>,
-    why: Vec<String>,
-}
-
-/// The strips of `regions` and their distances, each region on its own (in parallel;
-/// the results in region order).
-fn measure(
-    slices: &Slices,
-    regions: &[Region],
-    kept: &[bool],
-    measured: &BTreeMap<(u64, u64), f64>,
-    spacing: f64,
-) -> Round {
-    let levels = &slices.levels;
-    let built: Vec<Result<(Strip, f64), String>> = regions
-        .par_iter()
-        .map(|region| {
-            let key = (
-                levels[region.band].to_bits(),
-                levels[region.band + 1].to_bits(),
-            );
-            let strip = slices.strip(region, kept)?;
-            if strip.triangles.is_empty() {
-                return Err(format!(
-                    "a region between levels {} and {} is too small for a triangle",
-                    region.band,
-                    region.band + 1
-                ));
-            }
-            if measured.contains_key(&key) {
-                return Ok((strip, 0.0));
-            }
-            let soup = strip_soup(std::slice::from_ref(&strip));
-            let out = one_way_distance(&soup, &region.triangles, spacing);
-            let back = one_way_distance(&region.triangles, &soup, spacing);
-            Ok((strip, out.max(back)))
-        })
-        .collect();
-    let bands = levels.len() - 1;
-    let mut round = Round {
-        strips: Vec::with_capacity(regions.len()),
-        worst: vec![0.0; bands],
-        why: vec![String::new(); bands],
-    };
-    for (region, result) in regions.iter().zip(built) {
-        // A region no strip covers (the whole of a closed part) is split like one too
-        // far off.
-        let (strip, d) = result.unwrap_or_else(|e| {
-            round.why[region.band] = e;
-            let none = Strip {
-                points: Vec::new(),
-                triangles: Vec::new(),
-            };
-            (none, f64::INFINITY)
+/// The strips of `surface` between levels of `field`, each within `tolerance` of the
+/// part it covers (either way, measured at points `tolerance / 3` apart, allowing for
+/// the points between). From one band over each part of the surface, a band whose
+/// strip strays is cut across into sectors about `sector_length` long if it is longer
+/// (a ring round a body strays where the body is sharpest, and the rest of it need not
+/// be split with it), else split into equal bands, as many as should bring it within;
+/// each sector and band on its own, until none strays.
+pub fn strips_within(
+    surface: &Triangles,
+    field: &[f64],
+    tolerance: f64,
+    sector_length: f64,
+) -> Result<Banded, String> {
+    let (lo, hi) = field
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+            (lo.min(v), hi.max(v))
         });
-        round.worst[region.band] = round.worst[region.band].max(d);
-        round.strips.push(strip);
+    if lo > hi {
+        return Err("the surface has no points".into());
     }
-    round
+    let span = (hi - lo).max(1e-9);
+    let spacing = tolerance / 3.0;
+    let cover = Cover {
+        // Every point of a triangle lies within spacing/√3 of a sample.
+        within: tolerance - spacing / 3f64.sqrt(),
+        simplify: 0.15 * tolerance,
+        spacing,
+        sector_length,
+        span,
+    };
+    let whole = Patch {
+        surface: surface.clone(),
+        values: field.to_vec(),
+        kept: vec![true; surface.points.len()],
+        ends: [lo - 1e-3 * span, hi + 1e-3 * span],
+    };
+    let covered = cover.strips(&whole, Depth::default())?;
+    let deviation = covered.iter().map(|c| c.1).fold(0.0, f64::max);
+    let mut strips: Vec<Strip> = covered.into_iter().map(|c| c.0).collect();
+    conform(&mut strips);
+    Ok(Banded { strips, deviation })
+}
+
+/// How [`strips_within`] covers the surface.
+struct Cover {
+    /// The distance a strip may measure from its part, less the reach of the samples.
+    within: f64,
+    /// Each curve keeps the fewest points within this of it.
+    simplify: f64,
+    /// Samples for measuring lie no further apart than this.
+    spacing: f64,
+    /// Bands longer than this are cut into sectors before they are split.
+    sector_length: f64,
+    /// The field's span over the whole surface.
+    span: f64,
+}
+
+/// A connected part of the surface between two values of the field, covered by
+/// strips on its own.
+struct Patch {
+    surface: Triangles,
+    /// The field at each point.
+    values: Vec<f64>,
+    /// Whether the strips must keep each point (its neighbours beyond the patch do).
+    kept: Vec<bool>,
+    /// The values of the curves it lies between; its points there are on them.
+    ends: [f64; 2],
+}
+
+/// How deep a patch lies in the splitting, and whether its strips may fold over their
+/// outline (where no band of it keeps from that).
+#[derive(Clone, Copy, Debug, Default)]
+struct Depth {
+    splits: usize,
+    folds: bool,
+}
+
+impl Depth {
+    fn deeper(self) -> Depth {
+        Depth {
+            splits: self.splits + 1,
+            ..self
+        }
+    }
+}
+
+/// A strip and the distance measured between it and its part of the surface.
+type Covered = (Strip, f64);
+
+impl Cover {
+    /// The strips of `patch`: one if it is within, else those of its sectors or of
+    /// the bands it is split into.
+    fn strips(&self, patch: &Patch, depth: Depth) -> Result<Vec<Covered>, String> {
+        let [lo, hi] = patch.ends;
+        let margin = 1e-3 * (hi - lo);
+        let one = vec![lo - margin, hi + margin];
+        let whole = Slices::held(&patch.surface, &patch.values, one, Some(patch.ends));
+        let kept = whole.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        let regions = whole.regions();
+        if regions.len() > 1 {
+            return self.each(&whole, &regions, &kept, depth.deeper());
+        }
+        let Some(region) = regions.first() else {
+            return Ok(Vec::new());
+        };
+        let narrow = hi - lo < 1e-6 * self.span || depth.splits >= MOST_SPLITS;
+        let deviation = match self.measured(&whole, region, &kept, depth.folds) {
+            Ok((strip, d)) if d <= self.within => return Ok(vec![(strip, d)]),
+            Ok((_, d)) if narrow => {
+                return Err(format!(
+                    "a band of the field {lo}..{hi} stays {d:.3} mm from the surface"
+                ))
+            }
+            Ok((_, d)) => d,
+            Err(why) if narrow => return Err(why),
+            Err(_) => f64::INFINITY,
+        };
+        match self.sectors(patch) {
+            Sectors::Cut(sectors) => {
+                let depth = depth.deeper();
+                return flattened(sectors.par_iter().map(|s| self.strips(s, depth)));
+            }
+            Sectors::Short => {
+                let guess = match deviation.is_finite() {
+                    true => (hi - lo) * (self.within / deviation).sqrt(),
+                    false => 0.25 * (hi - lo),
+                };
+                if let Some(covered) = self.grown(patch, guess) {
+                    return Ok(covered);
+                }
+                // Every strip of some band folds over its outline (round a saddle):
+                // split it in equal bands, taking such strips.
+                return self.split(
+                    patch,
+                    deviation,
+                    Depth {
+                        folds: true,
+                        ..depth
+                    },
+                );
+            }
+            Sectors::Unfit => {}
+        }
+        self.split(patch, deviation, depth)
+    }
+
+    /// The strips of `patch` split into equal bands, as many as should bring a strip
+    /// `deviation` from it within: its distance grows about as its width squared.
+    fn split(&self, patch: &Patch, deviation: f64, depth: Depth) -> Result<Vec<Covered>, String> {
+        let [lo, hi] = patch.ends;
+        let margin = 1e-3 * (hi - lo);
+        let parts = match deviation.is_finite() {
+            true => ((deviation / self.within).sqrt().ceil() as usize).clamp(2, 8),
+            false => 4,
+        };
+        let mut sorted = patch.values.clone();
+        sorted.sort_by(f64::total_cmp);
+        let mut levels = vec![lo - margin];
+        levels.extend((1..parts).map(|k| {
+            let t = k as f64 / parts as f64;
+            off_values(lo + t * (hi - lo), &sorted)
+        }));
+        levels.push(hi + margin);
+        let split = Slices::held(&patch.surface, &patch.values, levels, Some(patch.ends));
+        let kept = split.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        self.each(&split, &split.regions(), &kept, depth.deeper())
+    }
+
+    /// The strips of each of `regions`, on its own (in parallel, in their order).
+    fn each(
+        &self,
+        slices: &Slices,
+        regions: &[Region],
+        kept: &[bool],
+        depth: Depth,
+    ) -> Result<Vec<Covered>, String> {
+        flattened(
+            regions
+                .par_iter()
+                .map(|r| self.strips(&slices.patch(r, kept), depth)),
+        )
+    }
+
+    /// The strip of `region` and the distance between them, either way; an error for
+    /// a strip that folds over its outline unless `folds`.
+    fn measured(
+        &self,
+        slices: &Slices,
+        region: &Region,
+        kept: &[bool],
+        folds: bool,
+    ) -> Result<Covered, String> {
+        let strip = slices.strip(region, kept)?;
+        if strip.triangles.is_empty() {
+            return Err(format!(
+                "a region between levels {} and {} is too small for a triangle",
+                region.band,
+                region.band + 1
+            ));
+        }
+        if !folds && slices.folds(region, &strip) {
+            return Err(format!(
+                "the strip of a region between levels {} and {} folds over its outline",
+                region.band,
+                region.band + 1
+            ));
+        }
+        let soup = strip_soup(std::slice::from_ref(&strip));
+        let out = one_way_distance(&soup, &region.triangles, self.spacing);
+        let back = one_way_distance(&region.triangles, &soup, self.spacing);
+        Ok((strip, out.max(back)))
+    }
+
+    /// `patch` cut across, from its lower curve to its upper one, into sectors about
+    /// [`Cover::sector_length`] long; `None` where it is shorter or has no way across.
+    fn sectors(&self, patch: &Patch) -> Sectors {
+        let corners = &patch.surface.corners;
+        let [lo, hi] = patch.ends;
+        let value = |i: u32| patch.values[i as usize];
+        let loops = boundary_loops(corners.iter().flat_map(|t| cycle_pairs(t)));
+        let lower: Vec<(Vec<u32>, bool)> = loops
+            .iter()
+            .flat_map(|l| runs(l, |i| value(i) == lo))
+            .collect();
+        let upper = loops
+            .iter()
+            .flat_map(|l| runs(l, |i| value(i) == hi))
+            .count();
+        let [(run, closed)] = lower.as_slice() else {
+            return Sectors::Unfit;
+        };
+        let sources = self.cut_points(patch, run, *closed);
+        if sources.is_empty() {
+            return Sectors::Short;
+        }
+        // Only a ring between its two curves, or a disk with one run on each: round a
+        // saddle the sectors would not be bands.
+        let ring = loops.len() == 2 && *closed && upper == 1;
+        let disk = loops.len() == 1 && upper == 1;
+        if !ring && !disk {
+            return Sectors::Unfit;
+        }
+        let across = Across::new(patch, &loops);
+        let mut cut: std::collections::BTreeSet<(u32, u32)> = Default::default();
+        let mut on_cut = vec![false; patch.values.len()];
+        for source in sources {
+            let Some((path, _)) = shortest_bridge(&[source], &across.links, |i| {
+                (value(i) == hi && patch.kept[i as usize]).then_some(0)
+            }) else {
+                continue;
+            };
+            for w in path.windows(2) {
+                cut.insert((w[0].min(w[1]), w[0].max(w[1])));
+            }
+            for &i in &path {
+                on_cut[i as usize] = true;
+            }
+        }
+        let groups = joined_triangles(corners, &cut);
+        if groups.len() < 2 {
+            return Sectors::Unfit;
+        }
+        let kept = |i: u32| patch.kept[i as usize] || on_cut[i as usize];
+        Sectors::Cut(groups.iter().map(|g| sub_patch(patch, g, &kept)).collect())
+    }
+
+    /// The strips of `patch` in bands from its lower curve up, each as wide as keeps
+    /// its strips within (found by widening and halving the step from `first`, a
+    /// guess), the last up to its upper curve.
+    fn grown(&self, patch: &Patch, first: f64) -> Option<Vec<Covered>> {
+        let [lo, hi] = patch.ends;
+        let mut sorted = patch.values.clone();
+        sorted.sort_by(f64::total_cmp);
+        let least = 1e-6 * self.span;
+        let mut covered = Vec::new();
+        let mut from = lo;
+        let mut step = first.max(least);
+        while from < hi {
+            // The widest band found within so far, and the narrowest found not.
+            let mut within: Option<(f64, Vec<Covered>)> = None;
+            let mut beyond = f64::INFINITY;
+            for _ in 0..MOST_TRIES {
+                let to = match from + step >= hi - 0.1 * step {
+                    true => hi,
+                    false => off_values(from + step, &sorted),
+                };
+                match self.band_within(patch, from, to) {
+                    Some(strips) => within = Some((to, strips)),
+                    None => beyond = beyond.min(to),
+                }
+                let reached = within.as_ref().map(|w| w.0);
+                step = match (reached, beyond.is_finite()) {
+                    (Some(to), _) if to >= hi => break,
+                    (None, _) => 0.6 * (to - from),
+                    (Some(to), false) => 1.5 * (to - from),
+                    // Within a tenth of the widest band that can be: enough.
+                    (Some(to), true) if beyond - to < 0.1 * (to - from) => break,
+                    (Some(to), true) => 0.5 * (to - from + beyond - from),
+                };
+                if within.is_none() && step < least {
+                    break;
+                }
+            }
+            // A thin band left at the top: two bands of half the rest instead.
+            let within = match within {
+                Some((to, _)) if to < hi && hi - to < 0.5 * (to - from) => {
+                    let half = off_values(0.5 * (from + hi), &sorted);
+                    let balanced = self.band_within(patch, from, half);
+                    balanced.map(|strips| (half, strips)).or(within)
+                }
+                within => within,
+            };
+            let (to, strips) = within?;
+            step = to - from;
+            covered.extend(strips);
+            from = to;
+        }
+        Some(covered)
+    }
+
+    /// The strips of the band of `patch` between values `from` and `to`, if every one
+    /// is within.
+    fn band_within(&self, patch: &Patch, from: f64, to: f64) -> Option<Vec<Covered>> {
+        let [lo, hi] = patch.ends;
+        let margin = 1e-3 * (hi - lo);
+        let mut levels = vec![lo - margin];
+        levels.extend([from, to].into_iter().filter(|&v| v > lo && v < hi));
+        levels.push(hi + margin);
+        let band = usize::from(from > lo);
+        let slices = Slices::held(&patch.surface, &patch.values, levels, Some(patch.ends));
+        let kept = slices.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        let regions: Vec<Region> = slices
+            .regions()
+            .into_iter()
+            .filter(|r| r.band == band)
+            .collect();
+        let measured: Vec<Option<Covered>> = regions
+            .par_iter()
+            .map(|r| {
+                let covered = self.measured(&slices, r, &kept, false).ok();
+                covered.filter(|c| c.1 <= self.within)
+            })
+            .collect();
+        measured.into_iter().collect()
+    }
+}
+
+/// What cutting a patch across gives.
+enum Sectors {
+    /// The sectors.
+    Cut(Vec<Patch>),
+    /// None: the patch is no longer than a sector.
+    Short,
+    /// None: the patch is not a band between one run of each curve, or has no way across.
+    Unfit,
+}
+
+impl Cover {
+    /// Where to cut a run of a patch's outline on its lower curve: its kept points
+    /// nearest even steps of [`Cover::sector_length`] or less along it (from its first
+    /// point on a closed run, between its ends on an open one); none on a run too
+    /// short to cut.
+    fn cut_points(&self, patch: &Patch, run: &[u32], closed: bool) -> Vec<u32> {
+        let at = |i: u32| patch.surface.points[i as usize];
+        let mut along = vec![0.0];
+        for w in run.windows(2) {
+            along.push(along[along.len() - 1] + at(w[0]).distance(at(w[1])));
+        }
+        let total = match (closed, run.first(), run.last()) {
+            (true, Some(&first), Some(&last)) => {
+                along[along.len() - 1] + at(last).distance(at(first))
+            }
+            _ => along[along.len() - 1],
+        };
+        let sectors = (total / self.sector_length).ceil() as usize;
+        if sectors < 2 {
+            return Vec::new();
+        }
+        let steps = if closed { 0..sectors } else { 1..sectors };
+        let mut points: Vec<u32> = steps
+            .filter_map(|k| {
+                let target = total * k as f64 / sectors as f64;
+                (0..run.len())
+                    .filter(|&j| patch.kept[run[j] as usize])
+                    .min_by(|&a, &b| {
+                        (along[a] - target)
+                            .abs()
+                            .total_cmp(&(along[b] - target).abs())
+                    })
+                    .map(|j| run[j])
+            })
+            .collect();
+        points.dedup();
+        points
+    }
+}
+
+/// The ways across a patch: its edges between two of its triangles, each upward into
+/// a point inside it or onto its outline's upper curve (so a cut runs from the lower
+/// curve to the upper one without running along the outline or back down).
+struct Across {
+    links: BTreeMap<u32, Vec<(u32, f64)>>,
+}
+
+impl Across {
+    fn new(patch: &Patch, loops: &[Vec<u32>]) -> Across {
+        let outline: std::collections::BTreeSet<u32> = loops.iter().flatten().copied().collect();
+        let mut uses: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+        for t in &patch.surface.corners {
+            for (a, b) in cycle_pairs(t) {
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let upper = |i: u32| patch.values[i as usize] == patch.ends[1];
+        let mut links: BTreeMap<u32, Vec<(u32, f64)>> = BTreeMap::new();
+        for (&(a, b), &n) in &uses {
+            if n != 2 {
+                continue;
+            }
+            let length =
+                patch.surface.points[a as usize].distance(patch.surface.points[b as usize]);
+            for (from, to) in [(a, b), (b, a)] {
+                // Only upward, so that each level between crosses the cut once; an edge
+                // costs its length over its rise (the field's values are lengths),
+                // times its length: a cut goes straight up rather than zigzag.
+                let rise = patch.values[to as usize] - patch.values[from as usize];
+                if rise > 0.0 && (!outline.contains(&to) || upper(to)) {
+                    links
+                        .entry(from)
+                        .or_default()
+                        .push((to, length * length / rise));
+                }
+            }
+        }
+        Across { links }
+    }
+}
+
+/// The results of `parts`, in order, each part's strips one after the other.
+fn flattened(
+    parts: impl IndexedParallelIterator<Item = Result<Vec<Covered>, String>>,
+) -> Result<Vec<Covered>, String> {
+    let parts: Vec<Result<Vec<Covered>, String>> = parts.collect();
+    let mut all = Vec::new();
+    for part in parts {
+        all.extend(part?);
+    }
+    Ok(all)
+}
+
+/// The maximal runs of `outline` (a loop) whose points are `on`, each with whether
+/// it is the whole loop.
+fn runs(outline: &[u32], on: impl Fn(u32) -> bool) -> Vec<(Vec<u32>, bool)> {
+    let n = outline.len();
+    let Some(off) = (0..n).find(|&k| !on(outline[k])) else {
+        return vec![(outline.to_vec(), true)];
+    };
+    let mut runs = Vec::new();
+    let mut run = Vec::new();
+    for k in 1..=n {
+        let i = outline[(off + k) % n];
+        if on(i) {
+            run.push(i);
+        } else if !run.is_empty() {
+            runs.push((std::mem::take(&mut run), false));
+        }
+    }
+    runs
+}
+
+/// The triangles of `corners` joined across their shared edges but those of `cut`:
+/// each group's triangles in order, the groups by their first.
+fn joined_triangles(
+    corners: &[[u32; 3]],
+    cut: &std::collections::BTreeSet<(u32, u32)>,
+) -> Vec<Vec<usize>> {
+    let mut parent: Vec<u32> = (0..corners.len() as u32).collect();
+    let mut first: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+    for (k, t) in corners.iter().enumerate() {
+        for (a, b) in cycle_pairs(t) {
+            let edge = (a.min(b), a.max(b));
+            if cut.contains(&edge) {
+                continue;
+            }
+            match first.get(&edge) {
+                Some(&other) => union(&mut parent, other, k as u32),
+                None => {
+                    first.insert(edge, k as u32);
+                }
+            }
+        }
+    }
+    let mut groups: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    for k in 0..corners.len() {
+        let root = find(&mut parent, k as u32);
+        groups.entry(root).or_default().push(k);
+    }
+    let mut groups: Vec<Vec<usize>> = groups.into_values().collect();
+    groups.sort_by_key(|g| g[0]);
+    groups
+}
+
+/// The patch of `patch`'s `triangles`, its points renumbered in their order, keeping
+/// those `kept` says, between the same ends.
+fn sub_patch(patch: &Patch, triangles: &[usize], kept: &dyn Fn(u32) -> bool) -> Patch {
+    let corners: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|&k| patch.surface.corners[k])
+        .collect();
+    let (ids, corners) = renumbered(&corners);
+    Patch {
+        surface: Triangles {
+            points: ids
+                .iter()
+                .map(|&i| patch.surface.points[i as usize])
+                .collect(),
+            corners,
+        },
+        values: ids.iter().map(|&i| patch.values[i as usize]).collect(),
+        kept: ids.iter().map(|&i| kept(i)).collect(),
+        ends: patch.ends,
+    }
+}
+
+/// The points `corners` use, increasing, and the corners as indices into them.
+fn renumbered(corners: &[[u32; 3]]) -> (Vec<u32>, Vec<[u32; 3]>) {
+    let mut ids: Vec<u32> = corners.iter().flatten().copied().collect();
+    ids.sort_unstable();
+    ids.dedup();
+    let index = |i: u32| ids.binary_search(&i).unwrap_or(0) as u32;
+    let corners = corners.iter().map(|t| t.map(index)).collect();
+    (ids, corners)
+}
+
+/// How far a point may be from an outline edge and count as on it (mm).
+const ON_EDGE: f64 = 1e-6;
+
+/// Every point of a strip's outline that lies inside an outline edge of another
+/// strip (where a band split on its own meets one that is not) made a corner of that
+/// edge too, its triangle fanned from the opposite corner, so the strips meet point
+/// for point.
+fn conform(strips: &mut [Strip]) {
+    weld_near(strips);
+    let outlines: Vec<Vec<(usize, u32, u32)>> = strips.iter().map(outline_of).collect();
+    let mut lengths: Vec<f64> = Vec::new();
+    let mut points: BTreeMap<[u64; 3], DVec3> = BTreeMap::new();
+    for (strip, outline) in strips.iter().zip(&outlines) {
+        for &(_, a, b) in outline {
+            let (pa, pb) = (strip.points[a as usize], strip.points[b as usize]);
+            lengths.push(pa.distance(pb));
+            points.insert(pa.to_array().map(f64::to_bits), pa);
+        }
+    }
+    if lengths.is_empty() {
+        return;
+    }
+    let cell = (lengths.iter().sum::<f64>() / lengths.len() as f64).max(1e-6);
+    let at = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
+    let mut grid: HashMap<[i32; 3], Vec<DVec3>> = HashMap::new();
+    for p in points.values() {
+        grid.entry(at(*p)).or_default().push(*p);
+    }
+    for (strip, outline) in strips.iter_mut().zip(outlines) {
+        for (_, a, b) in outline {
+            let (pa, pb) = (strip.points[a as usize], strip.points[b as usize]);
+            let inside = points_inside(pa, pb, cell, &|c| {
+                grid.get(&at(c)).map_or(&[][..], |v| &v[..])
+            });
+            if !inside.is_empty() {
+                split_outline_edge(strip, a, b, &inside);
+            }
+        }
+    }
+}
+
+/// How close two points of the strips are taken for one (mm): the same crossing found
+/// from levels a rounding apart.
+const SAME_POINT: f64 = 1e-7;
+
+/// The strips' points within [`SAME_POINT`] of each other moved onto one of them (the
+/// least by its bits), so that strips meeting there share it.
+fn weld_near(strips: &mut [Strip]) {
+    let key = |p: DVec3| p.to_array().map(f64::to_bits);
+    let cell = 1e3 * SAME_POINT;
+    let at = |p: DVec3| (p / cell).floor().as_ivec3().to_array();
+    let mut grid: HashMap<[i32; 3], Vec<DVec3>> = HashMap::new();
+    let mut all: BTreeMap<[u64; 3], DVec3> = BTreeMap::new();
+    for p in strips.iter().flat_map(|s| s.points.iter()) {
+        all.insert(key(*p), *p);
+    }
+    for p in all.values() {
+        grid.entry(at(*p)).or_default().push(*p);
+    }
+    let mut moved: HashMap<[u64; 3], DVec3> = HashMap::new();
+    for p in all.values() {
+        let mut least = *p;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let [x, y, z] = at(*p);
+                    for &q in grid.get(&[x + dx, y + dy, z + dz]).into_iter().flatten() {
+                        if q.distance(*p) < SAME_POINT && key(q) < key(least) {
+                            least = q;
+                        }
+                    }
+                }
+            }
+        }
+        if least != *p {
+            moved.insert(key(*p), least);
+        }
+    }
+    for strip in strips.iter_mut() {
+        for p in &mut strip.points {
+            if let Some(&q) = moved.get(&key(*p)) {
+                *p = q;
+            }
+        }
+    }
+}
+
+/// The points `near` gives (by the cell of a point) that lie inside segment `a`–`b`,
+/// from `a`.
+fn points_inside<'a>(
+    a: DVec3,
+    b: DVec3,
+    cell: f64,
+    near: &dyn Fn(DVec3) -> &'a [DVec3],
+) -> Vec<DVec3> {
+    let length = a.distance(b);
+    let steps = (2.0 * length / cell).ceil() as usize + 1;
+    let mut found: Vec<(f64, DVec3)> = Vec::new();
+    let mut seen: std::collections::BTreeSet<[u64; 3]> = Default::default();
+    for k in 0..=steps {
+        let sample = a.lerp(b, k as f64 / steps as f64);
+        for dx in [-1.0, 0.0, 1.0] {
+            for dy in [-1.0, 0.0, 1.0] {
+                for dz in [-1.0, 0.0, 1.0] {
+                    for &p in near(sample + cell * DVec3::new(dx, dy, dz)) {
+                        if p == a || p == b || !seen.insert(p.to_array().map(f64::to_bits)) {
+                            continue;
+                        }
+                        let t = (p - a).dot(b - a) / (length * length);
+                        if t > 0.0 && t < 1.0 && segment_distance(p, a, b) < ON_EDGE {
+                            found.push((t, p));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    found.sort_by(|x, y| x.0.total_cmp(&y.0));
+    found.into_iter().map(|f| f.1).collect()
+}
+
+/// The outline edges of `strip`: each triangle's side (index, from, to, as the
+/// triangle runs) no other of its triangles has.
+fn outline_of(strip: &Strip) -> Vec<(usize, u32, u32)> {
+    let mut uses: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+    for t in &strip.triangles {
+        for (a, b) in cycle_pairs(t) {
+            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let mut outline = Vec::new();
+    for (k, t) in strip.triangles.iter().enumerate() {
+        for (a, b) in cycle_pairs(t) {
+            if uses[&(a.min(b), a.max(b))] == 1 {
+                outline.push((k, a, b));
+            }
+        }
+    }
+    outline
+}
+
+/// `strip` with `inside` (points on its outline edge `a`→`b`, from `a`) made corners:
+/// the edge's triangle fanned from its third corner, in the order that keeps each
+/// triangle sharing a side with the next.
+fn split_outline_edge(strip: &mut Strip, a: u32, b: u32, inside: &[DVec3]) {
+    let Some(k) = strip
+        .triangles
+        .iter()
+        .position(|t| cycle_pairs(t).any(|e| e == (a, b)))
+    else {
+        return;
+    };
+    let t = strip.triangles[k];
+    let r = t.into_iter().find(|&v| v != a && v != b).unwrap_or(a);
+    let first = strip.points.len() as u32;
+    strip.points.extend_from_slice(inside);
+    let chain: Vec<u32> = std::iter::once(a)
+        .chain(first..first + inside.len() as u32)
+        .chain(std::iter::once(b))
+        .collect();
+    let mut fan: Vec<[u32; 3]> = chain.windows(2).map(|w| [w[0], w[1], r]).collect();
+    let has = |t: &[u32; 3], u: u32, v: u32| t.contains(&u) && t.contains(&v);
+    let from_b = match k.checked_sub(1) {
+        Some(before) => has(&strip.triangles[before], b, r),
+        None => strip
+            .triangles
+            .get(k + 1)
+            .is_some_and(|next| has(next, a, r)),
+    };
+    if from_b {
+        fan.reverse();
+    }
+    strip.triangles.splice(k..k + 1, fan);
 }
 
 /// `level`, moved up past any value of the field exactly at it (a cut must cross
@@ -1457,11 +2197,6 @@ impl Ord for Distance {
     }
 }
 
-/// The points of loop `ids`, last first.
-fn positions_reversed(slices: &Slices, ids: &[u32]) -> Vec<DVec3> {
-    ids.iter().rev().map(|&i| slices.point(i)).collect()
-}
-
 /// The consecutive pairs of a loop's corners, the last with the first.
 fn cycle_pairs(corners: &[u32]) -> impl Iterator<Item = (u32, u32)> + '_ {
     corners
@@ -1488,8 +2223,16 @@ fn clip(
         }
         if inside(a.1) != inside(b.1) {
             let edge = surface_edge(a.0, b.0);
-            let t = (value - a.1) / (b.1 - a.1);
-            out.push((Origin::Crossing { edge, level }, value, a.2.lerp(b.2, t)));
+            // From the end first by position, so that two patches sharing the edge
+            // find the same point to the bit.
+            let key = |c: &(Origin, f64, DVec3)| c.2.to_array().map(f64::to_bits);
+            let (from, to) = if key(&a) <= key(&b) { (a, b) } else { (b, a) };
+            let t = (value - from.1) / (to.1 - from.1);
+            out.push((
+                Origin::Crossing { edge, level },
+                value,
+                from.2.lerp(to.2, t),
+            ));
         }
     }
     out
@@ -2030,12 +2773,23 @@ mod tests {
     /// edge lengths kept unrolled, the strips on either side of each level meeting at
     /// the same points. Returns how many strips.
     fn check_strips(surface: &Triangles, field: &[f64], tolerance: f64) -> usize {
+        check_strips_cut(surface, field, tolerance, f64::INFINITY)
+    }
+
+    /// [`check_strips`] with bands cut into sectors `sector_length` long; every
+    /// outline edge of a strip is the surface's rim or another strip's outline edge,
+    /// run the other way.
+    fn check_strips_cut(
+        surface: &Triangles,
+        field: &[f64],
+        tolerance: f64,
+        sector_length: f64,
+    ) -> usize {
         let clock = std::time::Instant::now();
-        let banded = strips_within(surface, field, tolerance).unwrap();
+        let banded = strips_within(surface, field, tolerance, sector_length).unwrap();
         eprintln!(
-            "{} strips, {} levels, deviation {:.3} in {:?}",
+            "{} strips, deviation {:.3} in {:?}",
             banded.strips.len(),
-            banded.slices.levels.len(),
             banded.deviation,
             clock.elapsed()
         );
@@ -2062,28 +2816,48 @@ mod tests {
                 }
             }
         }
-        // Each point's level, by its position.
-        let slices = &banded.slices;
+        // Outline edges by their ends' positions, as the triangles run.
         let key = |p: DVec3| p.to_array().map(f64::to_bits);
-        let level_at: BTreeMap<[u64; 3], usize> = (0..slices.point_count() as u32)
-            .filter_map(|i| slices.level_of(i).map(|l| (key(slices.point(i)), l)))
+        let mut outlines: BTreeMap<([u64; 3], [u64; 3]), usize> = BTreeMap::new();
+        for (s, strip) in banded.strips.iter().enumerate() {
+            for (_, a, b) in outline_of(strip) {
+                let edge = (key(strip.points[a as usize]), key(strip.points[b as usize]));
+                assert!(
+                    outlines.insert(edge, s).is_none(),
+                    "strip {s} repeats an edge"
+                );
+            }
+        }
+        // No edge has more than two triangles: the strips do not overlap.
+        let mut uses: BTreeMap<([u64; 3], [u64; 3]), usize> = BTreeMap::new();
+        for strip in &banded.strips {
+            for t in &strip.triangles {
+                for (a, b) in cycle_pairs(t) {
+                    let (a, b) = (key(strip.points[a as usize]), key(strip.points[b as usize]));
+                    *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+                }
+            }
+        }
+        assert!(uses.values().all(|&n| n <= 2), "strips overlap");
+        let rim: std::collections::BTreeSet<([u64; 3], [u64; 3])> = rims(surface)
+            .iter()
+            .flat_map(|r| cycle_pairs(r).collect::<Vec<_>>())
+            .map(|(a, b)| {
+                (
+                    key(surface.points[a as usize]),
+                    key(surface.points[b as usize]),
+                )
+            })
             .collect();
-        for j in 1..slices.levels.len() - 1 {
-            let on_level = |band: usize| {
-                let mut at: Vec<[u64; 3]> = banded
-                    .regions
-                    .iter()
-                    .zip(&banded.strips)
-                    .filter(|(r, _)| r.band == band)
-                    .flat_map(|(_, s)| s.points.iter())
-                    .map(|&p| key(p))
-                    .filter(|k| level_at.get(k) == Some(&j))
-                    .collect();
-                at.sort();
-                at.dedup();
-                at
-            };
-            assert_eq!(on_level(j - 1), on_level(j), "level {j}");
+        for (&(a, b), &s) in &outlines {
+            // A ring strip meets itself at the rung it is opened at.
+            let from = |k: [u64; 3]| DVec3::from_array(k.map(f64::from_bits));
+            assert!(
+                rim.contains(&(a, b)) || outlines.contains_key(&(b, a)),
+                "an outline edge {} {} of strip {s} meets no other strip",
+                from(a),
+                from(b)
+            );
         }
         banded.strips.len()
     }
@@ -2122,7 +2896,11 @@ mod tests {
         let strips = check_strips(&sphere, &along(&sphere, DVec3::new(0.3, 0.2, 0.93)), 2.0);
         assert!(strips >= 3, "{strips}");
         // Between two poles, the same.
-        check_strips(&sphere, &two_pole_field(&sphere).unwrap(), 2.0);
+        let field = two_pole_field(&sphere).unwrap();
+        let whole = check_strips(&sphere, &field, 2.0);
+        // Rings longer than 200 mm cut across into sectors, each split on its own.
+        let cut = check_strips_cut(&sphere, &field, 2.0, 200.0);
+        assert!(cut > whole, "{cut} sectors and bands, {whole} rings");
     }
 
     /// A torus about the z axis: `around` × `across` quads split into triangles.
@@ -2152,7 +2930,9 @@ mod tests {
         // Along an axis in its plane the field has two saddles, where a band's
         // region has three loops.
         let torus = torus(100.0, 40.0, 48, 24);
-        check_strips(&torus, &along(&torus, DVec3::new(1.0, 0.2, 0.1)), 2.0);
+        let field = along(&torus, DVec3::new(1.0, 0.2, 0.1));
+        check_strips(&torus, &field, 2.0);
+        check_strips_cut(&torus, &field, 2.0, 150.0);
     }
 
     #[test]
