@@ -256,8 +256,7 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
         &two_pole_field(&surface).map_err(SchemeError::Model)?,
     );
     // Bands are cut across into sectors about as long as the sheet's shorter side: an
-    // unrolled sector is an arc, and shorter arcs nest closer (the bunny at 4 ft on
-    // 18x24 in took 214 pieces on 27 sheets so, 189 on 33 at the longer side).
+    // unrolled sector is an arc, and shorter arcs nest closer (docs/benchmarks.md).
     let sector_length = options
         .net
         .panel
@@ -1016,19 +1015,10 @@ pub struct Region {
 
 impl Slices {
     /// `surface` cut along `levels` (increasing, none equal to a value of `field` at a
-    /// corner, so every cut crosses edges between their ends).
-    pub fn new(surface: &Triangles, field: &[f64], levels: Vec<f64>) -> Slices {
-        Slices::held(surface, field, levels, None)
-    }
-
-    /// [`Slices::new`] of a patch whose corners at the values `held` (below the
-    /// second level and above the last but one) lie on the first and last levels.
-    fn held(
-        surface: &Triangles,
-        field: &[f64],
-        levels: Vec<f64>,
-        held: Option<[f64; 2]>,
-    ) -> Slices {
+    /// corner, so every cut crosses edges between their ends). On a patch, its corners
+    /// at the values `held` (below the second level and above the last but one) lie on
+    /// the first and last levels.
+    fn new(surface: &Triangles, field: &[f64], levels: Vec<f64>, held: Option<[f64; 2]>) -> Slices {
         let mut slices = Slices {
             levels,
             points: Vec::new(),
@@ -1088,11 +1078,6 @@ impl Slices {
         self.points[id as usize]
     }
 
-    /// How many points the slices have.
-    pub fn point_count(&self) -> usize {
-        self.points.len()
-    }
-
     /// The level point `id` lies on, if it is a crossing.
     pub fn level_of(&self, id: u32) -> Option<usize> {
         match self.origins[id as usize] {
@@ -1149,12 +1134,8 @@ impl Slices {
     /// of its pieces shares) chained into loops, and its triangles.
     fn region(&self, band: usize, pieces: &[usize]) -> Region {
         let loops = boundary_loops(pieces.iter().flat_map(|&k| cycle_pairs(&self.pieces[k].1)));
-        let triangles = pieces
-            .iter()
-            .flat_map(|&k| {
-                let c = &self.pieces[k].1;
-                (1..c.len() - 1).map(move |i| [c[0], c[i], c[i + 1]])
-            })
+        let triangles = self
+            .fans(pieces)
             .map(|t| t.map(|i| self.point(i)))
             .collect();
         Region {
@@ -1164,18 +1145,21 @@ impl Slices {
             pieces: pieces.to_vec(),
         }
     }
+
+    /// The triangles of `pieces`, each convex piece fanned from its first corner.
+    fn fans<'a>(&'a self, pieces: &'a [usize]) -> impl Iterator<Item = [u32; 3]> + 'a {
+        pieces.iter().flat_map(|&k| {
+            let c = &self.pieces[k].1;
+            (1..c.len() - 1).map(move |i| [c[0], c[i], c[i + 1]])
+        })
+    }
 }
 
 impl Slices {
-    /// Which points the strips keep: every corner of the surface, and of each level's
-    /// curves the fewest points within `tolerance` of them ([`simplify`]), the same
-    /// for the regions on either side of the curve.
-    pub fn kept(&self, tolerance: f64) -> Vec<bool> {
-        self.kept_with(tolerance, &|_| true)
-    }
-
-    /// [`Slices::kept`], keeping of the surface's corners those `corner_kept` says.
-    fn kept_with(&self, tolerance: f64, corner_kept: &dyn Fn(u32) -> bool) -> Vec<bool> {
+    /// Which points the strips keep: the surface's corners `corner_kept` says, and of
+    /// each level's curves the fewest points within `tolerance` of them
+    /// ([`simplify`]), the same for the regions on either side of the curve.
+    fn kept(&self, tolerance: f64, corner_kept: &dyn Fn(u32) -> bool) -> Vec<bool> {
         let mut keep: Vec<bool> = self
             .origins
             .iter()
@@ -1206,14 +1190,7 @@ impl Slices {
     /// `region` as a patch of its own: its pieces fanned into triangles, keeping the
     /// points `kept`, between its band's levels (or the values they stand for).
     fn patch(&self, region: &Region, kept: &[bool]) -> Patch {
-        let fans: Vec<[u32; 3]> = region
-            .pieces
-            .iter()
-            .flat_map(|&k| {
-                let c = &self.pieces[k].1;
-                (1..c.len() - 1).map(move |i| [c[0], c[i], c[i + 1]])
-            })
-            .collect();
+        let fans: Vec<[u32; 3]> = self.fans(&region.pieces).collect();
         let (ids, corners) = renumbered(&fans);
         let last = self.levels.len() - 1;
         let end = |level: usize| match (self.held, level) {
@@ -1235,13 +1212,8 @@ impl Slices {
     /// The strip of `region`, its corners the points `kept`: between its two loops
     /// (one on each level), or, for a region with one loop, between the run of that
     /// loop on its lower level (or half of it) and the rest.
-    pub fn strip(&self, region: &Region, kept: &[bool]) -> Result<Strip, String> {
-        self.strip_facing(region, kept, true)
-    }
-
-    /// [`Slices::strip`], its triangles kept from facing away from the surface if
-    /// `facing` ([`band_facing`]).
-    fn strip_facing(&self, region: &Region, kept: &[bool], facing: bool) -> Result<Strip, String> {
+    /// With `facing`, no triangle faces away from the surface ([`band_facing`]).
+    fn strip(&self, region: &Region, kept: &[bool], facing: bool) -> Result<Strip, String> {
         let loops: Vec<Vec<u32>> = region
             .loops
             .iter()
@@ -1333,14 +1305,14 @@ impl Slices {
     fn normals(&self, region: &Region) -> BTreeMap<u32, DVec3> {
         let mut normals: BTreeMap<u32, DVec3> = BTreeMap::new();
         for &k in &region.pieces {
-            let c = &self.pieces[k].1;
-            let normal: DVec3 = (1..c.len() - 1)
-                .map(|i| {
-                    let [a, b, d] = [c[0], c[i], c[i + 1]].map(|v| self.point(v));
+            let normal: DVec3 = self
+                .fans(std::slice::from_ref(&k))
+                .map(|t| {
+                    let [a, b, d] = t.map(|v| self.point(v));
                     (b - a).cross(d - a)
                 })
                 .sum();
-            for &v in c {
+            for &v in &self.pieces[k].1 {
                 *normals.entry(v).or_insert(DVec3::ZERO) += normal;
             }
         }
@@ -1555,8 +1527,7 @@ impl Cover {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
         let one = vec![lo - margin, hi + margin];
-        let whole = Slices::held(&patch.surface, &patch.values, one, Some(patch.ends));
-        let kept = whole.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        let (whole, kept) = self.sliced(patch, one);
         let regions = whole.regions();
         if regions.len() > 1 {
             return self.each(&whole, &regions, &kept, depth.deeper());
@@ -1622,9 +1593,16 @@ impl Cover {
             off_values(lo + t * (hi - lo), &sorted)
         }));
         levels.push(hi + margin);
-        let split = Slices::held(&patch.surface, &patch.values, levels, Some(patch.ends));
-        let kept = split.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        let (split, kept) = self.sliced(patch, levels);
         self.each(&split, &split.regions(), &kept, depth.deeper())
+    }
+
+    /// `patch` cut along `levels` (its first and last outside it), and the points its
+    /// strips keep: those its neighbours keep, and the fewest along each new curve.
+    fn sliced(&self, patch: &Patch, levels: Vec<f64>) -> (Slices, Vec<bool>) {
+        let slices = Slices::new(&patch.surface, &patch.values, levels, Some(patch.ends));
+        let kept = slices.kept(self.simplify, &|v| patch.kept[v as usize]);
+        (slices, kept)
     }
 
     /// The strips of each of `regions`, on its own (in parallel, in their order).
@@ -1651,7 +1629,7 @@ impl Cover {
         kept: &[bool],
         folds: bool,
     ) -> Result<Covered, String> {
-        let strip = slices.strip_facing(region, kept, !folds)?;
+        let strip = slices.strip(region, kept, !folds)?;
         if strip.triangles.is_empty() {
             return Err(format!(
                 "a region between levels {} and {} is too small for a triangle",
@@ -1788,8 +1766,7 @@ impl Cover {
         levels.extend([from, to].into_iter().filter(|&v| v > lo && v < hi));
         levels.push(hi + margin);
         let band = usize::from(from > lo);
-        let slices = Slices::held(&patch.surface, &patch.values, levels, Some(patch.ends));
-        let kept = slices.kept_with(self.simplify, &|v| patch.kept[v as usize]);
+        let (slices, kept) = self.sliced(patch, levels);
         let regions: Vec<Region> = slices
             .regions()
             .into_iter()
@@ -1866,12 +1843,7 @@ struct Across {
 impl Across {
     fn new(patch: &Patch, loops: &[Vec<u32>]) -> Across {
         let outline: std::collections::BTreeSet<u32> = loops.iter().flatten().copied().collect();
-        let mut uses: BTreeMap<(u32, u32), u32> = BTreeMap::new();
-        for t in &patch.surface.corners {
-            for (a, b) in cycle_pairs(t) {
-                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
+        let uses = edge_uses(&patch.surface.corners);
         let upper = |i: u32| patch.values[i as usize] == patch.ends[1];
         let mut links: BTreeMap<u32, Vec<(u32, f64)>> = BTreeMap::new();
         for (&(a, b), &n) in &uses {
@@ -2114,15 +2086,21 @@ fn points_inside<'a>(
     found.into_iter().map(|f| f.1).collect()
 }
 
-/// The outline edges of `strip`: each triangle's side (index, from, to, as the
-/// triangle runs) no other of its triangles has.
-fn outline_of(strip: &Strip) -> Vec<(usize, u32, u32)> {
+/// How many of `triangles` use each edge (by its corners, lower first).
+fn edge_uses(triangles: &[[u32; 3]]) -> BTreeMap<(u32, u32), u32> {
     let mut uses: BTreeMap<(u32, u32), u32> = BTreeMap::new();
-    for t in &strip.triangles {
+    for t in triangles {
         for (a, b) in cycle_pairs(t) {
             *uses.entry((a.min(b), a.max(b))).or_default() += 1;
         }
     }
+    uses
+}
+
+/// The outline edges of `strip`: each triangle's side (index, from, to, as the
+/// triangle runs) no other of its triangles has.
+fn outline_of(strip: &Strip) -> Vec<(usize, u32, u32)> {
+    let uses = edge_uses(&strip.triangles);
     let mut outline = Vec::new();
     for (k, t) in strip.triangles.iter().enumerate() {
         for (a, b) in cycle_pairs(t) {
@@ -2620,19 +2598,6 @@ mod tests {
         surface.points.iter().map(|p| p.z).collect()
     }
 
-    /// The edges used by one triangle only: the strip's outline.
-    fn outline_edges(strip: &Strip) -> BTreeMap<(u32, u32), usize> {
-        let mut uses = BTreeMap::new();
-        for t in &strip.triangles {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
-            }
-        }
-        uses.retain(|_, n| *n == 1);
-        uses
-    }
-
     /// The harmonic field of a wide cone between its rims crowds toward the narrow
     /// rim (it goes as the log of the radius); evened, it runs evenly along the slant.
     #[test]
@@ -2725,10 +2690,10 @@ mod tests {
         let strip = ring(&rims[0], &rims[1]);
         assert_eq!(strip.triangles.len(), 2 * around);
         // Every corner on the outline: no vertex inside the band.
-        let outline = outline_edges(&strip);
+        let outline = outline_of(&strip);
         for v in strip.triangles.iter().flatten() {
             assert!(
-                outline.keys().any(|&(a, b)| a == *v || b == *v),
+                outline.iter().any(|&(_, a, b)| a == *v || b == *v),
                 "{v} inside"
             );
         }
@@ -2838,10 +2803,10 @@ mod tests {
         assert!(out <= tolerance && back <= tolerance, "{out} {back}");
         let size = extent_of(&surface.points);
         for strip in &banded.strips {
-            let outline = outline_edges(strip);
+            let outline = outline_of(strip);
             for v in strip.triangles.iter().flatten() {
                 assert!(
-                    outline.keys().any(|&(a, b)| a == *v || b == *v),
+                    outline.iter().any(|&(_, a, b)| a == *v || b == *v),
                     "{v} inside"
                 );
             }
