@@ -1475,6 +1475,7 @@ pub fn strips_within(
 }
 
 /// How [`strips_within`] covers the surface.
+#[derive(Clone, Copy)]
 struct Cover {
     /// The distance a strip may measure from its part, less the reach of the samples.
     within: f64,
@@ -1549,8 +1550,18 @@ impl Cover {
         };
         match self.sectors(patch) {
             Sectors::Cut(sectors) => {
-                let depth = depth.deeper();
-                return flattened(sectors.par_iter().map(|s| self.strips(s, depth)));
+                let deeper = depth.deeper();
+                let covered = flattened(sectors.par_iter().map(|s| self.strips(s, deeper)))?;
+                if joined(&covered) {
+                    return Ok(covered);
+                }
+                // A sector's strip folded over onto its neighbour (round a sharp tip):
+                // this band is covered whole instead.
+                let whole = Cover {
+                    sector_length: f64::INFINITY,
+                    ..*self
+                };
+                return whole.strips(patch, depth);
             }
             Sectors::Short => {
                 let guess = match deviation.is_finite() {
@@ -1867,6 +1878,14 @@ impl Across {
         }
         Across { links }
     }
+}
+
+/// Whether the strips of `covered` join into one surface where they meet (none folded
+/// over onto another).
+fn joined(covered: &[Covered]) -> bool {
+    let mut strips: Vec<Strip> = covered.iter().map(|c| c.0.clone()).collect();
+    conform(&mut strips);
+    Welded::new(&strips).is_ok()
 }
 
 /// The results of `parts`, in order, each part's strips one after the other.
@@ -2984,5 +3003,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn strips_folded_over_their_neighbour_do_not_join() {
+        let at = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        let strip = |points: Vec<DVec3>| -> Covered {
+            let triangles = vec![[0, 1, 2]];
+            (Strip { points, triangles }, 0.0)
+        };
+        let below = strip(vec![at(0.0, 0.0), at(1.0, 0.0), at(1.0, 1.0)]);
+        // Beyond their shared edge, and folded back over it onto the first strip.
+        let beside = strip(vec![at(1.0, 1.0), at(1.0, 0.0), at(2.0, 0.5)]);
+        let folded = strip(vec![at(1.0, 0.0), at(1.0, 1.0), at(0.5, 0.2)]);
+        assert!(joined(&[below.clone(), beside]));
+        assert!(!joined(&[below, folded]));
     }
 }
