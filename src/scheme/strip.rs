@@ -936,6 +936,12 @@ fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
 /// The largest distance from `from` to `to` (triangle sets), measured at points
 /// spread over `from`'s triangles no further than `spacing` apart.
 pub fn one_way_distance(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64) -> f64 {
+    distance_beyond(from, to, spacing, f64::INFINITY)
+}
+
+/// [`one_way_distance`], or the first distance measured beyond `limit`: enough to
+/// tell whether `from` is within it.
+fn distance_beyond(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64, limit: f64) -> f64 {
     let grid = TriangleGrid::new(to);
     let mut worst: f64 = 0.0;
     for t in from {
@@ -953,6 +959,9 @@ pub fn one_way_distance(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64) ->
                 let point = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
                 worst = worst.max(grid.distance(point));
             }
+        }
+        if worst > limit {
+            break;
         }
     }
     worst
@@ -1537,7 +1546,7 @@ impl Cover {
             return Ok(Vec::new());
         };
         let narrow = hi - lo < 1e-6 * self.span || depth.splits >= MOST_SPLITS;
-        let deviation = match self.measured(&whole, region, &kept, depth.folds) {
+        let deviation = match self.measured(&whole, region, &kept, depth.folds, f64::INFINITY) {
             Ok((strip, d)) if d <= self.within => return Ok(vec![(strip, d)]),
             Ok((_, d)) if narrow => {
                 return Err(format!(
@@ -1631,14 +1640,16 @@ impl Cover {
         )
     }
 
-    /// The strip of `region` and the distance between them, either way; an error for
-    /// a strip that folds over its outline unless `folds`.
+    /// The strip of `region` and the distance between them, either way (or the first
+    /// distance found beyond `limit`); an error for a strip that folds over its
+    /// outline unless `folds`.
     fn measured(
         &self,
         slices: &Slices,
         region: &Region,
         kept: &[bool],
         folds: bool,
+        limit: f64,
     ) -> Result<Covered, String> {
         let strip = slices.strip(region, kept, !folds)?;
         if strip.triangles.is_empty() {
@@ -1656,8 +1667,11 @@ impl Cover {
             ));
         }
         let soup = strip_soup(std::slice::from_ref(&strip));
-        let out = one_way_distance(&soup, &region.triangles, self.spacing);
-        let back = one_way_distance(&region.triangles, &soup, self.spacing);
+        let out = distance_beyond(&soup, &region.triangles, self.spacing, limit);
+        if out > limit {
+            return Ok((strip, out));
+        }
+        let back = distance_beyond(&region.triangles, &soup, self.spacing, limit);
         Ok((strip, out.max(back)))
     }
 
@@ -1786,7 +1800,7 @@ impl Cover {
         let measured: Vec<Option<Covered>> = regions
             .par_iter()
             .map(|r| {
-                let covered = self.measured(&slices, r, &kept, false).ok();
+                let covered = self.measured(&slices, r, &kept, false, self.within).ok();
                 covered.filter(|c| c.1 <= self.within)
             })
             .collect();
