@@ -202,6 +202,34 @@ impl<'a> TriangleGrid<'a> {
         best.map(|(t, q, _)| (t, q))
     }
 
+    /// Whether some triangle lies within `r` of `p`: found by the first such triangle,
+    /// without looking for the nearest. (A triangle at a hair more or less than `r`
+    /// may be missed or taken: callers use it to skip work, not to decide.)
+    pub fn reaches(&self, p: DVec3, r: f64) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let home = [0, 1, 2].map(|k| cell_index(p, k, self.lo, self.cell, self.dims));
+        let max_ring = self.dims.iter().copied().max().unwrap_or(1);
+        for ring in 0..=max_ring {
+            if ring > 0 && self.inside_distance(p, home, ring - 1) > r {
+                return false;
+            }
+            let mut found = false;
+            self.visit_ring(home, ring, |t| {
+                if found || box_distance(p, self.boxes[t]) > r {
+                    return;
+                }
+                let [a, b, c] = self.triangles[t];
+                found = closest_point_on_triangle(p, a, b, c).distance(p) <= r;
+            });
+            if found {
+                return true;
+            }
+        }
+        false
+    }
+
     /// How far `p` lies inside the box of the cells within Chebyshev distance `ring`
     /// of `home` (0 when outside it).
     fn inside_distance(&self, p: DVec3, home: [usize; 3], ring: usize) -> f64 {
@@ -292,6 +320,8 @@ mod tests {
                 .map(|[a, b, c]| closest_point_on_triangle(p, *a, *b, *c).distance(p))
                 .fold(f64::INFINITY, f64::min);
             assert!((grid.distance(p) - brute).abs() < 1e-12, "{p}");
+            assert!(grid.reaches(p, brute + 1e-9), "{p}");
+            assert!(!grid.reaches(p, brute - 1e-9), "{p}");
         }
     }
 }

@@ -957,7 +957,11 @@ fn distance_beyond(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64, limit: 
             for j in 0..=k - i {
                 let (u, v) = (i as f64 / k as f64, j as f64 / k as f64);
                 let point = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
-                worst = worst.max(grid.distance(point));
+                // A point with a triangle no further than the worst so far cannot
+                // raise it: only the others are measured to their nearest.
+                if !grid.reaches(point, worst) {
+                    worst = worst.max(grid.distance(point));
+                }
             }
         }
         if worst > limit {
