@@ -271,8 +271,8 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
     };
     let mut banded = within(sector_length)?;
     let mut welded = Welded::new(&banded.strips);
-    // Where a strip of a sector still folds over onto its neighbour (round a sharp
-    // tip), the bands are kept whole instead.
+    // Each band's sectors were checked to join as they were cut; where strips of
+    // neighbouring bands still overlap, every band is kept whole instead.
     let whole_bands = welded.is_err() && sector_length.is_finite();
     if whole_bands {
         banded = within(f64::INFINITY)?;
@@ -939,8 +939,8 @@ pub fn one_way_distance(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64) ->
     distance_beyond(from, to, spacing, f64::INFINITY)
 }
 
-/// [`one_way_distance`], or the first distance measured beyond `limit`: enough to
-/// tell whether `from` is within it.
+/// [`one_way_distance`], or, once it passes `limit`, some distance beyond it: enough
+/// to tell whether `from` is within `limit`.
 fn distance_beyond(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64, limit: f64) -> f64 {
     let grid = TriangleGrid::new(to);
     let mut worst: f64 = 0.0;
@@ -1644,9 +1644,9 @@ impl Cover {
         )
     }
 
-    /// The strip of `region` and the distance between them, either way (or the first
-    /// distance found beyond `limit`); an error for a strip that folds over its
-    /// outline unless `folds`.
+    /// The strip of `region` and the distance between them, either way (or, once it
+    /// passes `limit`, some distance beyond it); an error for a strip that folds over
+    /// its outline unless `folds`.
     fn measured(
         &self,
         slices: &Slices,
