@@ -348,6 +348,35 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
     }
 }
 
+/// A band whose sectors' strips fold onto each other is covered whole on its own: on
+/// the faceted torus two bands do, and the rest of the model keeps its sectors.
+#[test]
+fn sectors_that_overlap_are_mended_in_their_own_band() {
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let (m, run) = build_run(
+        "strip",
+        &model("torus-8x6"),
+        "1ft",
+        &out,
+        &["--sheet", "18x24in", "--format", "svg,dxf"],
+    );
+    assert!(run.stderr.contains("strip: "), "no report:\n{}", run.stderr);
+    assert!(
+        !run.stderr.contains("bands run whole"),
+        "every band went whole:\n{}",
+        run.stderr
+    );
+    check_output(
+        &model("torus-8x6"),
+        &out,
+        &m,
+        "torus-8x6",
+        DxfCheck::FirstAndLast,
+        |e| e["id"].as_str().unwrap().to_string(),
+    );
+}
+
 #[test]
 fn the_bunny_is_strips_within_the_bound() {
     let Some(shared) = shared_models("the_bunny_is_strips_within_the_bound") else {
