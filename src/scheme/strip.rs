@@ -1569,12 +1569,13 @@ impl Cover {
                     return Ok(covered);
                 }
                 // A sector's strip folded over onto its neighbour (round a sharp tip):
-                // this band is covered whole instead.
-                let whole = Cover {
-                    sector_length: f64::INFINITY,
+                // this band is cut into sectors twice as long instead, and once they
+                // would be longer than it, covered whole.
+                let longer = Cover {
+                    sector_length: 2.0 * self.sector_length,
                     ..*self
                 };
-                return whole.strips(patch, depth);
+                return longer.strips(patch, depth);
             }
             Sectors::Short => {
                 let guess = match deviation.is_finite() {
