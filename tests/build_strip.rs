@@ -348,8 +348,9 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
     }
 }
 
-/// A band whose sectors' strips fold onto each other is covered whole on its own: on
-/// the faceted torus two bands do, and the rest of the model keeps its sectors.
+/// A band whose sectors' strips fold onto each other is mended on its own (cut into
+/// longer sectors, or covered whole): on the faceted torus two bands are, and the rest
+/// of the model keeps its sectors.
 #[test]
 fn sectors_that_overlap_are_mended_in_their_own_band() {
     let tmp = TempDir::new().unwrap();
