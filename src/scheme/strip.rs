@@ -303,7 +303,7 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
     )];
     if whole_bands {
         output.report.push(format!(
-            "strip: bands run whole round the model, not cut into sectors {sector_length:.0} mm long (a sector's strip folded over onto its neighbour)"
+            "strip: bands run whole round the model, not cut into sectors {sector_length:.0} mm long (strips of neighbouring bands overlapped)"
         ));
     }
     output
