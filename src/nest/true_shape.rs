@@ -29,6 +29,7 @@
 //! optional cap on the improvement and the squeeze, and the only source of
 //! run-to-run differences when it is hit.
 
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -204,6 +205,8 @@ struct Nester<'a> {
     /// The budgeted phase's share of the progress display: thousandths before it and
     /// its own, from how many checks it spends from which.
     budget_share: (u32, u32, u64, u64),
+    /// Set when a trial move tried before this copy's succeeded: this copy stops.
+    given_up: Vec<Arc<AtomicBool>>,
 }
 
 /// The share of a search's progress display (thousandths) its construction takes, the
@@ -549,6 +552,31 @@ impl<'a> Nester<'a> {
             time_limit: options.time_limit.unwrap_or(Duration::MAX),
             progress: None,
             budget_share: (0, 0, 0, 1),
+            given_up: Vec::new(),
+        }
+    }
+
+    /// A copy of the search to try a move on: the same sheets, random stream, checks
+    /// and budget, with buffers of its own.
+    fn trial(&self) -> Nester<'a> {
+        Nester {
+            parts: self.parts,
+            container: self.container.clone(),
+            bounds: self.bounds,
+            rng: self.rng.clone(),
+            samples: self.samples,
+            scratch: self.scratch.clone(),
+            scratch_part: self.scratch_part,
+            sheets: self.sheets.clone(),
+            checks: self.checks,
+            largest_area: self.largest_area,
+            overlap: separate::OverlapScratch::default(),
+            budget: self.budget,
+            started: self.started,
+            time_limit: self.time_limit,
+            progress: self.progress,
+            budget_share: self.budget_share,
+            given_up: Vec::new(),
         }
     }
 

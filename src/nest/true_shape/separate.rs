@@ -22,7 +22,10 @@
 //! collision costs something, tab tips included), times the geometric mean of the
 //! square roots of their convex hulls' areas (large parts left overlapping cost more).
 
+use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 use jagua_rs::collision_detection::hazards::collector::BasicHazardCollector;
 use jagua_rs::collision_detection::hazards::filter::NoFilter;
@@ -371,6 +374,11 @@ impl Nester<'_> {
 
     /// Moves `part` from sheet `from` into one of the emptiest other sheets by overlap
     /// minimisation (see [`Nester::squeeze_emptiest`]); `false` leaves it where it was.
+    ///
+    /// The sheets are tried at once, each on its own copy of the search from the same
+    /// state: the first, emptiest first, whose separation succeeds is kept, and the
+    /// checks count as if they had been tried one after the other up to it. The result
+    /// is the same on one thread as on several.
     fn squeeze_part(&mut self, from: usize, part: usize, rounds: usize) -> bool {
         let parts = self.parts;
         let mut by_fill: Vec<(f32, usize)> = (0..self.sheets.len())
@@ -385,24 +393,57 @@ impl Nester<'_> {
             })
             .collect();
         by_fill.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for &(_, s) in by_fill.iter().take(SQUEEZE_SHEETS) {
-            if self.out_of_budget() {
-                break;
-            }
-            let backup = self.sheets[s].clone();
-            let c = self.least_overlap_pose(s, part, None, &Weights::default());
-            self.put(s, part, c);
-            // The sheet was free of overlaps: the part's own are all there are.
-            let mut pairs = Pairs::new();
-            self.record_overlaps(s, part, &mut pairs);
-            if self.separate(s, rounds, pairs) {
+        if self.out_of_budget() {
+            return false;
+        }
+        // A trial gives up once one before it has succeeded: its outcome would not count.
+        let succeeded: Vec<Arc<AtomicBool>> = (0..SQUEEZE_SHEETS)
+            .map(|_| Arc::new(AtomicBool::new(false)))
+            .collect();
+        let trials: Vec<(usize, Nester)> = by_fill
+            .iter()
+            .take(SQUEEZE_SHEETS)
+            .enumerate()
+            .map(|(k, &(_, s))| {
+                let mut trial = self.trial();
+                trial.given_up = succeeded[..k].to_vec();
+                (s, trial)
+            })
+            .collect();
+        let tried: Vec<(usize, Nester, bool)> = trials
+            .into_par_iter()
+            .enumerate()
+            .map(|(k, (s, mut trial))| {
+                let fits = trial.squeeze_into(s, part, rounds);
+                if fits {
+                    succeeded[k].store(true, Ordering::Relaxed);
+                }
+                (s, trial, fits)
+            })
+            .collect();
+        let start = self.checks;
+        for (s, mut trial, fits) in tried {
+            self.checks += trial.checks - start;
+            self.rng = trial.rng.clone();
+            if fits {
+                std::mem::swap(&mut self.sheets[s], &mut trial.sheets[s]);
                 let slot = self.slot_of(from, part);
                 self.take_off(from, vec![slot]);
                 return true;
             }
-            self.sheets[s] = backup;
         }
         false
+    }
+
+    /// Puts `part` (still on its own sheet too) on sheet `s` at its pose of least
+    /// overlap and separates that sheet; whether it came free of overlaps.
+    fn squeeze_into(&mut self, s: usize, part: usize, rounds: usize) -> bool {
+        let c = self.least_overlap_pose(s, part, None, &Weights::default());
+        self.put(s, part, c);
+        // The sheet was free of overlaps: the part's own are all there are.
+        let mut pairs = Pairs::new();
+        self.record_overlaps(s, part, &mut pairs);
+        self.separate(s, rounds, pairs)
     }
 
     /// Whether the current phase (improvement or squeeze) has spent its collision
@@ -410,7 +451,9 @@ impl Nester<'_> {
     pub(super) fn out_of_budget(&self) -> bool {
         let (before, weight, first, spend) = self.budget_share;
         self.report(before, weight, self.checks - first, spend);
-        self.checks >= self.budget || self.started.elapsed() >= self.time_limit
+        self.checks >= self.budget
+            || self.started.elapsed() >= self.time_limit
+            || self.given_up.iter().any(|g| g.load(Ordering::Relaxed))
     }
 
     /// Every overlapping pair on sheet `s`, with its overlap.
