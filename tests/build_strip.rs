@@ -378,6 +378,32 @@ fn sectors_that_overlap_are_mended_in_their_own_band() {
     );
 }
 
+/// Round genus2's saddles a piece's faces can wrap round a corner of its strip's side
+/// until two of their edges lie on one line (its outline would meet itself): such a
+/// piece is cut at a rung, and the model builds at every size.
+#[test]
+fn a_piece_that_would_wrap_onto_itself_is_cut_in_two() {
+    for size in ["300mm", "350mm"] {
+        let tmp = TempDir::new().unwrap();
+        let out = tmp.path().join("out");
+        let extra = ["--sheet", "18x24in", "--format", "svg,dxf"];
+        let (m, run) = build_run("strip", &model("genus2"), size, &out, &extra);
+        assert!(
+            run.stderr.contains("strip: "),
+            "no report at {size}:\n{}",
+            run.stderr
+        );
+        check_output(
+            &model("genus2"),
+            &out,
+            &m,
+            "genus2",
+            DxfCheck::FirstAndLast,
+            |e| e["id"].as_str().unwrap().to_string(),
+        );
+    }
+}
+
 #[test]
 fn the_bunny_is_strips_within_the_bound() {
     let Some(shared) = shared_models("the_bunny_is_strips_within_the_bound") else {

@@ -24,7 +24,9 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
-use super::net::{islands_along, FlatFoldArgs, IslandNames, NetOptions, OwnNet, FLAT_FOLD_DEG};
+use super::net::{
+    islands_along, FlatFoldArgs, IslandNames, IslandNet, NetOptions, OwnNet, FLAT_FOLD_DEG,
+};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{Scheme, SchemeError, SchemeOutput};
 use crate::mesh::distance::{segment_distance, TriangleGrid};
@@ -279,22 +281,12 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
         welded = Welded::new(&banded.strips);
     }
     let welded = welded.map_err(SchemeError::Model)?;
-    let names = |members: &[Vec<u32>]| welded.names(members);
     // Each curve's tabs on the strip below it: the strip above is glued over them.
     let tab_first = |h: HalfedgeId| {
         let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
         strip(h) <= strip(h.twin())
     };
-    let own = OwnNet {
-        names: &names,
-        tab_first: &tab_first,
-    };
-    let net = islands_along(
-        &welded.mesh,
-        &options.net,
-        &welded.folds,
-        &IslandNames::Own(own),
-    );
+    let net = clear_pieces(&welded, &options.net, &tab_first);
     let mut output = net.output;
     let pieces = output.panels.len();
     output.report = vec![format!(
@@ -316,6 +308,57 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
     output.manifest.push("strip", section);
     output.surface = Some(welded.mesh);
     Ok(output)
+}
+
+/// The pieces: islands grown along the strips' rungs, in order. A piece whose outline,
+/// tabs included, meets itself when unrolled (its faces wrap round a corner of its
+/// strip's side until two of their edges lie on one line) is cut at its middle rung
+/// and the pieces are grown again.
+fn clear_pieces(
+    welded: &Welded,
+    options: &NetOptions,
+    tab_first: &dyn Fn(HalfedgeId) -> bool,
+) -> IslandNet {
+    // The faces of each piece, in the order of the panels, as the net names them.
+    let members = std::cell::RefCell::new(Vec::new());
+    let names = |faces: &[Vec<u32>]| {
+        *members.borrow_mut() = faces.to_vec();
+        welded.names(faces)
+    };
+    let mut folds = welded.folds.clone();
+    loop {
+        let own = OwnNet {
+            names: &names,
+            tab_first,
+        };
+        let net = islands_along(&welded.mesh, options, &folds, &IslandNames::Own(own));
+        let members = members.borrow();
+        let cut = net.output.panels.iter().enumerate().find_map(|(k, panel)| {
+            let flat = crate::flatten::flatten(panel).ok()?;
+            if crate::plane::is_simple(&flat.outer()) {
+                return None;
+            }
+            middle_rung(&welded.mesh, &members[k], &folds)
+        });
+        match cut {
+            Some(rung) => folds.retain(|&e| e != rung),
+            None => return net,
+        }
+    }
+}
+
+/// The fold between two faces of `faces` (a run of one strip) nearest its middle.
+fn middle_rung(mesh: &Mesh, faces: &[u32], folds: &[EdgeId]) -> Option<EdgeId> {
+    let mid = faces.len() / 2;
+    let mut order: Vec<usize> = (1..faces.len()).collect();
+    order.sort_by_key(|&k| k.abs_diff(mid));
+    order.into_iter().find_map(|k| {
+        let (a, b) = (FaceId(faces[k - 1]), FaceId(faces[k]));
+        mesh.face_half_edges(a)
+            .find(|h| mesh.face(h.twin()) == Some(b))
+            .map(|h| h.edge())
+            .filter(|e| folds.contains(e))
+    })
 }
 
 /// True when triangle `t` has an area above rounding noise (its height more than a
