@@ -353,21 +353,22 @@ fn middle_rung(mesh: &Mesh, faces: &[u32], folds: &[EdgeId]) -> Option<EdgeId> {
     let mut order: Vec<usize> = (1..faces.len()).collect();
     order.sort_by_key(|&k| k.abs_diff(mid));
     order.into_iter().find_map(|k| {
-        let (a, b) = (FaceId(faces[k - 1]), FaceId(faces[k]));
-        mesh.face_half_edges(a)
-            .find(|h| mesh.face(h.twin()) == Some(b))
-            .map(|h| h.edge())
-            .filter(|e| folds.contains(e))
+        shared_edge(mesh, FaceId(faces[k - 1]), FaceId(faces[k])).filter(|e| folds.contains(e))
     })
+}
+
+/// The edge faces `a` and `b` share, if they are neighbours.
+fn shared_edge(mesh: &Mesh, a: FaceId, b: FaceId) -> Option<EdgeId> {
+    mesh.face_half_edges(a)
+        .find(|h| mesh.face(h.twin()) == Some(b))
+        .map(|h| h.edge())
 }
 
 /// True when triangle `t` has an area above rounding noise (its height more than a
 /// billionth of its longest side).
 fn has_area(t: [DVec3; 3]) -> bool {
     let twice_area = (t[1] - t[0]).cross(t[2] - t[0]).length();
-    let longest = (0..3)
-        .map(|k| t[k].distance(t[(k + 1) % 3]))
-        .fold(0.0, f64::max);
+    let longest = longest_side(&t);
     twice_area > 2e-9 * longest * longest
 }
 
@@ -424,10 +425,7 @@ impl Welded {
             if strip_of_face[f] != strip_of_face[f - 1] {
                 continue;
             }
-            let shared = mesh
-                .face_half_edges(FaceId(f as u32 - 1))
-                .find(|h| mesh.face(h.twin()) == Some(FaceId(f as u32)));
-            folds.extend(shared.map(|h| h.edge()));
+            folds.extend(shared_edge(&mesh, FaceId(f as u32 - 1), FaceId(f as u32)));
         }
         Ok(Welded {
             mesh,
@@ -1026,6 +1024,7 @@ fn distance_beyond(
     bound
 }
 
+/// The longest side of triangle `t`.
 fn longest_side(t: &[DVec3; 3]) -> f64 {
     [
         t[0].distance(t[1]),

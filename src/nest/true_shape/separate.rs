@@ -424,7 +424,7 @@ impl Nester<'_> {
         let start = self.checks;
         for (s, mut trial, fits) in tried {
             self.checks += trial.checks - start;
-            self.rng = trial.rng.clone();
+            self.rng = trial.rng;
             if fits {
                 std::mem::swap(&mut self.sheets[s], &mut trial.sheets[s]);
                 let slot = self.slot_of(from, part);
