@@ -996,7 +996,14 @@ impl Raster {
         let x1 = (hi.x as usize).min(self.width);
         let y1 = (hi.y as usize).min(self.height);
         for y in lo.y as usize..y1 {
-            for x in lo.x as usize..x1 {
+            // Only the cells whose centres the row's span may hold are tested: a thin
+            // triangle's box is mostly outside it.
+            let Some((from, to)) = row_span(t.map(|c| c.0), area, y as f64 + 0.5) else {
+                continue;
+            };
+            let from = (from.floor() - 1.0).max(lo.x) as usize;
+            let to = ((to.ceil() + 2.0).max(0.0) as usize).min(x1);
+            for x in from..to {
                 let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
                 let wa = (b - p).perp_dot(c - p) / area;
                 let wb = (c - p).perp_dot(a - p) / area;
@@ -1030,6 +1037,38 @@ impl Raster {
             (y - 1..=y + 1).all(|j| (x - 1..=x + 1).all(|i| owners[j * self.width + i] == owner));
         owner.filter(|_| around)
     }
+}
+
+/// The cells of the row whose centres lie at height `y` that triangle `t` (of signed
+/// area `area`, doubled) may cover, as a range of cell indices, with a cell to spare
+/// either side; `None` where it covers none. Each barycentric weight is linear along
+/// the row, so each side bounds the range from one end.
+fn row_span(t: [DVec2; 3], area: f64, y: f64) -> Option<(f64, f64)> {
+    let [a, b, c] = t;
+    let weight = |p: DVec2, q: DVec2, x: f64| {
+        let at = DVec2::new(x, y);
+        (p - at).perp_dot(q - at) / area
+    };
+    let (mut from, mut to) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (p, q) in [(b, c), (c, a), (a, b)] {
+        // The weight at the centres of cells 0 and 1, and the x (a cell index) where it
+        // falls to the test's allowance.
+        let w0 = weight(p, q, 0.5);
+        let slope = weight(p, q, 1.5) - w0;
+        if slope.abs() < 1e-12 {
+            if w0 < -1e-6 {
+                return None;
+            }
+            continue;
+        }
+        let edge = (-1e-6 - w0) / slope;
+        if slope > 0.0 {
+            from = from.max(edge);
+        } else {
+            to = to.min(edge);
+        }
+    }
+    (from <= to + 1.0).then_some((from, to))
 }
 
 /// Text boxes already written in a view, bucketed on a grid for the collision test.
@@ -1075,5 +1114,57 @@ impl Placed {
             }
         }
         true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every cell whose centre a triangle holds, tested one by one over its box.
+    fn cells_by_box(raster: &Raster, t: [DVec2; 3]) -> Vec<usize> {
+        let [a, b, c] = t;
+        let area = (b - a).perp_dot(c - a);
+        let mut cells = Vec::new();
+        for y in 0..raster.height {
+            for x in 0..raster.width {
+                let p = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                let wa = (b - p).perp_dot(c - p) / area;
+                let wb = (c - p).perp_dot(a - p) / area;
+                if wa >= -1e-9 && wb >= -1e-9 && 1.0 - wa - wb >= -1e-9 {
+                    cells.push(y * raster.width + x);
+                }
+            }
+        }
+        cells
+    }
+
+    #[test]
+    fn a_triangle_covers_the_cells_its_box_test_finds_thin_or_not() {
+        let raster = Raster::new(DVec2::ZERO, DVec2::new(30.0, 20.0));
+        let size = DVec2::new(raster.width as f64, raster.height as f64);
+        let mut rng = crate::rng::SplitMix64::new(7);
+        let mut point = || DVec2::new(rng.unit(), rng.unit()) * size * 1.2 - 0.1 * size;
+        let mut covered = 0;
+        for k in 0..400 {
+            let (a, b) = (point(), point());
+            // Every other triangle a sliver: its third corner a hair off the side ab.
+            let c = match k % 2 {
+                0 => point(),
+                _ => a.lerp(b, 0.37) + (b - a).perp().normalize() * 0.3,
+            };
+            let t = [a, b, c];
+            let mut owner = vec![None; raster.width * raster.height];
+            let mut depth = vec![f64::NEG_INFINITY; owner.len()];
+            raster.triangle(t.map(|p| (p, 0.0)), Some(1), &mut owner, &mut depth);
+            let cells: Vec<usize> = (0..owner.len()).filter(|&i| owner[i].is_some()).collect();
+            let expected = match (b - a).perp_dot(c - a).abs() < 1e-12 {
+                true => Vec::new(),
+                false => cells_by_box(&raster, t),
+            };
+            assert_eq!(cells, expected, "triangle {k}: {t:?}");
+            covered += cells.len();
+        }
+        assert!(covered > 10_000, "{covered} cells covered in all");
     }
 }
