@@ -1040,9 +1040,10 @@ impl Raster {
 }
 
 /// The cells of the row whose centres lie at height `y` that triangle `t` (of signed
-/// area `area`, doubled) may cover, as a range of cell indices, with a cell to spare
-/// either side; `None` where it covers none. Each barycentric weight is linear along
-/// the row, so each side bounds the range from one end.
+/// area `area`, doubled) may cover, as a range of cell indices found with an allowance
+/// looser than the cells' own test (the caller pads it by a cell as well); `None`
+/// where it covers none. Each barycentric weight is linear along the row, so each
+/// side bounds the range from one end.
 fn row_span(t: [DVec2; 3], area: f64, y: f64) -> Option<(f64, f64)> {
     let [a, b, c] = t;
     let weight = |p: DVec2, q: DVec2, x: f64| {
@@ -1055,7 +1056,7 @@ fn row_span(t: [DVec2; 3], area: f64, y: f64) -> Option<(f64, f64)> {
         // falls to the test's allowance.
         let w0 = weight(p, q, 0.5);
         let slope = weight(p, q, 1.5) - w0;
-        if slope.abs() < 1e-12 {
+        if slope == 0.0 {
             if w0 < -1e-6 {
                 return None;
             }
