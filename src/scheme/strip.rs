@@ -332,13 +332,13 @@ fn clear_pieces(
             tab_first,
         };
         let net = islands_along(&welded.mesh, options, &folds, &IslandNames::Own(own));
-        let members = members.borrow();
+        let faces_of = members.borrow();
         let cut = net.output.panels.iter().enumerate().find_map(|(k, panel)| {
             let flat = crate::flatten::flatten(panel).ok()?;
             if crate::plane::is_simple(&flat.outer()) {
                 return None;
             }
-            middle_rung(&welded.mesh, &members[k], &folds)
+            middle_rung(&welded.mesh, &faces_of[k], &folds)
         });
         match cut {
             Some(rung) => folds.retain(|&e| e != rung),
