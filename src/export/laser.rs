@@ -149,19 +149,13 @@ pub struct Group {
 /// order and where the beam ends. Ties go to the earlier group or path, so the order
 /// is the same on every run.
 pub fn order(groups: Vec<Group>, mut at: DVec2) -> (Vec<Path>, DVec2) {
+    let entries = Entries::new(&groups);
     let mut left: Vec<Option<Group>> = groups.into_iter().map(Some).collect();
     let mut out = Vec::new();
     for _ in 0..left.len() {
-        // The group whose entry is nearest.
-        let mut best: Option<(f64, usize)> = None;
-        for (i, g) in left.iter().enumerate() {
-            let Some(g) = g else { continue };
-            let d = entry_distance(g, at);
-            if best.is_none_or(|(b, _)| d < b) {
-                best = Some((d, i));
-            }
-        }
-        let Some((_, i)) = best else { break };
+        let Some(i) = entries.nearest(at, &left) else {
+            break;
+        };
         let group = left[i].take().expect("chosen groups are present");
         let (paths, end) = order_group(group, at);
         out.extend(paths);
@@ -170,8 +164,120 @@ pub fn order(groups: Vec<Group>, mut at: DVec2) -> (Vec<Path>, DVec2) {
     (out, at)
 }
 
-/// How far the beam moves from `at` to start `group`.
-fn entry_distance(group: &Group, at: DVec2) -> f64 {
+/// Where each group can be entered ([`entry_points`]), in square cells, so that the
+/// nearest group is found among the cells round the beam instead of among all groups
+/// (a sheet's labels and folds run to thousands of groups).
+struct Entries {
+    origin: DVec2,
+    cell: f64,
+    columns: usize,
+    rows: usize,
+    /// Per cell, its entry points and their groups, in group order.
+    cells: Vec<Vec<(usize, DVec2)>>,
+}
+
+impl Entries {
+    fn new(groups: &[Group]) -> Entries {
+        let points: Vec<(usize, DVec2)> = groups
+            .iter()
+            .enumerate()
+            .flat_map(|(i, g)| entry_points(g).map(move |p| (i, p)))
+            .collect();
+        let (lo, hi) = points.iter().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &(_, p)| (lo.min(p), hi.max(p)),
+        );
+        let size = (hi - lo).max(DVec2::splat(1e-9));
+        // About one point a cell.
+        let cell = (size.x * size.y / points.len().max(1) as f64)
+            .sqrt()
+            .max(size.x.max(size.y) / 1024.0);
+        let columns = ((size.x / cell) as usize + 1).max(1);
+        let rows = ((size.y / cell) as usize + 1).max(1);
+        let mut entries = Entries {
+            origin: lo,
+            cell,
+            columns,
+            rows,
+            cells: vec![Vec::new(); if points.is_empty() { 0 } else { columns * rows }],
+        };
+        for (i, p) in points {
+            let (c, r) = entries.cell_of(p);
+            entries.cells[r * columns + c].push((i, p));
+        }
+        entries
+    }
+
+    /// The column and row of the cell `p` falls in (clamped to the grid).
+    fn cell_of(&self, p: DVec2) -> (usize, usize) {
+        let q = (p - self.origin) / self.cell;
+        let clamp = |v: f64, n: usize| (v.max(0.0) as usize).min(n - 1);
+        (clamp(q.x, self.columns), clamp(q.y, self.rows))
+    }
+
+    /// The group still `left` whose entry is nearest `at`, the earliest on a tie:
+    /// rings of cells are searched outward until no cell beyond can hold a nearer
+    /// entry (or as near, which keeps the tie to the earliest group exact).
+    fn nearest(&self, at: DVec2, left: &[Option<Group>]) -> Option<usize> {
+        if self.cells.is_empty() {
+            return None;
+        }
+        let far = self.origin + self.cell * DVec2::new(self.columns as f64, self.rows as f64);
+        let inner = at.clamp(self.origin, far);
+        let (c, r) = self.cell_of(inner);
+        let (c, r) = (c as i64, r as i64);
+        let mut best: Option<(f64, usize)> = None;
+        let most = self.columns.max(self.rows) as i64;
+        for ring in 0..=most {
+            for (x, y) in ring_cells(c, r, ring) {
+                if x < 0 || y < 0 || x >= self.columns as i64 || y >= self.rows as i64 {
+                    continue;
+                }
+                for &(i, p) in &self.cells[y as usize * self.columns + x as usize] {
+                    if left[i].is_none() {
+                        continue;
+                    }
+                    let d = p.distance(at);
+                    if best.is_none_or(|(b, j)| d < b || (d == b && i < j)) {
+                        best = Some((d, i));
+                    }
+                }
+            }
+            // Every entry outside the searched square lies at least as far from `at`
+            // as from `inner` (`at` moved into the grid's box, which is convex), and
+            // that is at least `inner`'s distance to the square's sides.
+            let square = |k: i64| self.cell * k as f64;
+            let beyond = DVec2::new(
+                (inner.x - self.origin.x - square(c - ring))
+                    .min(self.origin.x + square(c + ring + 1) - inner.x),
+                (inner.y - self.origin.y - square(r - ring))
+                    .min(self.origin.y + square(r + ring + 1) - inner.y),
+            );
+            if best.is_some_and(|(b, _)| b < beyond.x.min(beyond.y)) {
+                break;
+            }
+        }
+        best.map(|(_, i)| i)
+    }
+}
+
+/// The cells at Chebyshev distance `ring` from cell (`c`, `r`).
+fn ring_cells(c: i64, r: i64, ring: i64) -> impl Iterator<Item = (i64, i64)> {
+    (-ring..=ring).flat_map(move |dy| {
+        let step = if dy.abs() == ring {
+            1
+        } else {
+            (2 * ring).max(1)
+        };
+        (-ring..=ring)
+            .step_by(step as usize)
+            .map(move |dx| (c + dx, r + dy))
+    })
+}
+
+/// The points the beam can enter `group` at: the starts of the paths it may run
+/// first, and the ends of those that run either way.
+fn entry_points(group: &Group) -> impl Iterator<Item = DVec2> + '_ {
     let free = if group.last_fixed {
         &group.paths[..group.paths.len().saturating_sub(1)]
     } else {
@@ -182,17 +288,10 @@ fn entry_distance(group: &Group, at: DVec2) -> f64 {
     } else {
         free
     };
-    candidates
-        .iter()
-        .map(|p| {
-            let d = p.start().distance(at);
-            if p.reversible() {
-                d.min(p.end().distance(at))
-            } else {
-                d
-            }
-        })
-        .fold(f64::INFINITY, f64::min)
+    candidates.iter().flat_map(|p| {
+        let end = p.reversible().then(|| p.end());
+        std::iter::once(p.start()).chain(end)
+    })
 }
 
 /// A group's paths in running order from `at`, and where the beam ends.
@@ -276,6 +375,65 @@ mod tests {
             ]
         );
         assert_eq!(end, DVec2::new(100.0, 0.0));
+    }
+
+    /// The nearest group by measuring every one, the earliest on a tie: what the
+    /// cells must find.
+    fn nearest_by_every_group(groups: &[Option<Group>], at: DVec2) -> Option<usize> {
+        let mut best: Option<(f64, usize)> = None;
+        for (i, g) in groups.iter().enumerate() {
+            let Some(g) = g else { continue };
+            let d = entry_points(g)
+                .map(|p| p.distance(at))
+                .fold(f64::INFINITY, f64::min);
+            if best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, i));
+            }
+        }
+        best.map(|(_, i)| i)
+    }
+
+    #[test]
+    fn the_cells_find_the_group_every_group_measured_finds() {
+        let mut rng = crate::rng::SplitMix64::new(7);
+        for trial in 0..40 {
+            // Many groups on a coarse lattice, so that equal distances (ties) are common.
+            let count = 1 + trial * 7;
+            let groups: Vec<Group> = (0..count)
+                .map(|k| {
+                    let mut point = || {
+                        let mut coordinate = || rng.below(400) as f64 * 0.25;
+                        DVec2::new(coordinate(), coordinate())
+                    };
+                    let paths: Vec<Path> = (0..1 + k % 3)
+                        .map(|j| Path::Polyline {
+                            points: vec![point(), point()],
+                            closed: (k + j) % 4 == 0,
+                        })
+                        .collect();
+                    Group {
+                        paths,
+                        last_fixed: k % 5 == 1,
+                        keep_order: k % 7 == 3,
+                    }
+                })
+                .collect();
+            let entries = Entries::new(&groups);
+            let mut left: Vec<Option<Group>> = groups.into_iter().map(Some).collect();
+            // From inside the groups' box, from outside it, then from each group's end.
+            let mut at = DVec2::new(-50.0, 130.0);
+            for step in 0..count {
+                let found = entries.nearest(at, &left);
+                assert_eq!(
+                    found,
+                    nearest_by_every_group(&left, at),
+                    "trial {trial} step {step}"
+                );
+                let i = found.expect("groups are left");
+                at = left[i].take().unwrap().paths[0].end();
+            }
+            assert_eq!(entries.nearest(at, &left), None);
+        }
     }
 
     #[test]
