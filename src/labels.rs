@@ -347,24 +347,48 @@ fn box_fits(
             return false;
         }
     }
-    // Clear of holes and score lines.
+    // Clear of holes and score lines. What lies beyond the box's bounds, farther than
+    // it must keep clear, is passed untested (a label box is tried at many places).
+    let (lo, hi) = bounds(bx);
+    let beyond = |points: &[DVec2], clear: f64| {
+        let reach = clear + 1e-6;
+        points.iter().all(|p| p.x < lo.x - reach)
+            || points.iter().all(|p| p.x > hi.x + reach)
+            || points.iter().all(|p| p.y < lo.y - reach)
+            || points.iter().all(|p| p.y > hi.y + reach)
+    };
     for hole in &panel.holes {
         let clear = 0.5 * hole.diameter + margin;
+        if beyond(&[hole.center], clear) {
+            continue;
+        }
         if contains(bx, hole.center) || distance_to_border(bx, hole.center) < clear {
             return false;
         }
     }
     for &Fold { ends: [a, b], .. } in &panel.folds {
         let (p, q) = (panel.points[a as usize], panel.points[b as usize]);
+        if beyond(&[p, q], 0.0) {
+            continue;
+        }
         if contains(bx, p) || (0..4).any(|k| segments_intersect(p, q, bx[k], bx[(k + 1) % 4])) {
             return false;
         }
     }
-    // Clear of labels already placed: their boxes grown by the gap between labels.
+    // Clear of labels already placed: their boxes grown by the gap between labels
+    // (a box grown by d reaches at most d√2 further along either axis).
     placed.iter().all(|other| {
         let gap = margin.max(LABEL_GAP * height.max(other.height));
-        !polygons_touch(bx, &grow(&other.bx, gap))
+        beyond(&other.bx, 1.5 * gap) || !polygons_touch(bx, &grow(&other.bx, gap))
     })
+}
+
+/// The corners of the axis-aligned box round `points`.
+fn bounds(points: &[DVec2]) -> (DVec2, DVec2) {
+    points.iter().fold(
+        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    )
 }
 
 /// A box grown by `d` on every side.

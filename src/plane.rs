@@ -98,6 +98,11 @@ pub fn perimeter(poly: &[DVec2]) -> f64 {
 
 /// Distance from a point to a segment.
 pub fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    squared_distance_to_segment(p, a, b).sqrt()
+}
+
+/// The square of [`distance_to_segment`].
+fn squared_distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     let ab = b - a;
     let len2 = ab.length_squared();
     let t = if len2 > 0.0 {
@@ -105,14 +110,17 @@ pub fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
     } else {
         0.0
     };
-    p.distance(a + t * ab)
+    p.distance_squared(a + t * ab)
 }
 
-/// Distance from a point to a polygon's border.
+/// Distance from a point to a polygon's border. (One square root of the least
+/// square: the root is rounded correctly and never decreases, so this is the least
+/// of the sides' distances to the bit.)
 pub fn distance_to_border(poly: &[DVec2], p: DVec2) -> f64 {
     (0..poly.len())
-        .map(|i| distance_to_segment(p, poly[i], poly[(i + 1) % poly.len()]))
+        .map(|i| squared_distance_to_segment(p, poly[i], poly[(i + 1) % poly.len()]))
         .fold(f64::INFINITY, f64::min)
+        .sqrt()
 }
 
 /// True when segments ab and cd share a point (touching counts).
