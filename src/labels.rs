@@ -349,9 +349,9 @@ fn box_fits(
     }
     // Clear of holes and score lines. What lies beyond the box's bounds, farther than
     // it must keep clear, is passed untested (a label box is tried at many places).
-    let (lo, hi) = bounds(bx);
+    let (lo, hi) = crate::plane::bounds(bx.iter().copied());
     let beyond = |points: &[DVec2], clear: f64| {
-        let reach = clear + 1e-6;
+        let reach = clear.max(0.0) + 1e-6;
         points.iter().all(|p| p.x < lo.x - reach)
             || points.iter().all(|p| p.x > hi.x + reach)
             || points.iter().all(|p| p.y < lo.y - reach)
@@ -381,14 +381,6 @@ fn box_fits(
         let gap = margin.max(LABEL_GAP * height.max(other.height));
         beyond(&other.bx, 1.5 * gap) || !polygons_touch(bx, &grow(&other.bx, gap))
     })
-}
-
-/// The corners of the axis-aligned box round `points`.
-fn bounds(points: &[DVec2]) -> (DVec2, DVec2) {
-    points.iter().fold(
-        (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-        |(lo, hi), &p| (lo.min(p), hi.max(p)),
-    )
 }
 
 /// A box grown by `d` on every side.

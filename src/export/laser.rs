@@ -215,6 +215,23 @@ impl Entries {
         (clamp(q.x, self.columns), clamp(q.y, self.rows))
     }
 
+    /// The cells of the grid at Chebyshev distance `ring` from cell (`c`, `r`).
+    fn ring_cells(&self, c: i64, r: i64, ring: i64) -> impl Iterator<Item = (usize, usize)> {
+        let (columns, rows) = (self.columns as i64, self.rows as i64);
+        let across = (c - ring).max(0)..=(c + ring).min(columns - 1);
+        ((r - ring).max(0)..=(r + ring).min(rows - 1)).flat_map(move |y| {
+            // The ring's top and bottom rows whole, its other rows at both ends.
+            let xs: Vec<i64> = match (y - r).abs() == ring {
+                true => across.clone().collect(),
+                false => [c - ring, c + ring]
+                    .into_iter()
+                    .filter(|&x| x >= 0 && x < columns)
+                    .collect(),
+            };
+            xs.into_iter().map(move |x| (x as usize, y as usize))
+        })
+    }
+
     /// The group still `left` whose entry is nearest `at`, the earliest on a tie:
     /// rings of cells are searched outward until no cell beyond can hold a nearer
     /// entry (or as near, which keeps the tie to the earliest group exact).
@@ -228,16 +245,20 @@ impl Entries {
         let (c, r) = (c as i64, r as i64);
         let mut best: Option<(f64, usize)> = None;
         let most = self.columns.max(self.rows) as i64;
+        // Rounding in the cells' bounds, far below any distance that matters.
+        let slack = 1e-9 * (far - self.origin).abs().max_element().max(1.0);
         for ring in 0..=most {
-            for (x, y) in ring_cells(c, r, ring) {
-                if x < 0 || y < 0 || x >= self.columns as i64 || y >= self.rows as i64 {
-                    continue;
-                }
-                for &(i, p) in &self.cells[y as usize * self.columns + x as usize] {
+            for (x, y) in self.ring_cells(c, r, ring) {
+                for &(i, p) in &self.cells[y * self.columns + x] {
                     if left[i].is_none() {
                         continue;
                     }
-                    let d = p.distance(at);
+                    // An entry at no number is as far as can be (as every group with
+                    // only such entries is).
+                    let d = match p.distance(at) {
+                        d if d.is_nan() => f64::INFINITY,
+                        d => d,
+                    };
                     if best.is_none_or(|(b, j)| d < b || (d == b && i < j)) {
                         best = Some((d, i));
                     }
@@ -253,26 +274,12 @@ impl Entries {
                 (inner.y - self.origin.y - square(r - ring))
                     .min(self.origin.y + square(r + ring + 1) - inner.y),
             );
-            if best.is_some_and(|(b, _)| b < beyond.x.min(beyond.y)) {
+            if best.is_some_and(|(b, _)| b < beyond.x.min(beyond.y) - slack) {
                 break;
             }
         }
         best.map(|(_, i)| i)
     }
-}
-
-/// The cells at Chebyshev distance `ring` from cell (`c`, `r`).
-fn ring_cells(c: i64, r: i64, ring: i64) -> impl Iterator<Item = (i64, i64)> {
-    (-ring..=ring).flat_map(move |dy| {
-        let step = if dy.abs() == ring {
-            1
-        } else {
-            (2 * ring).max(1)
-        };
-        (-ring..=ring)
-            .step_by(step as usize)
-            .map(move |dx| (c + dx, r + dy))
-    })
 }
 
 /// The points the beam can enter `group` at: the starts of the paths it may run
@@ -393,46 +400,65 @@ mod tests {
         best.map(|(_, i)| i)
     }
 
+    /// Groups of paths with corners on a lattice (so that equal distances, ties, are
+    /// common), on one line when `flat`, some without paths and one at no number.
+    fn lattice_groups(rng: &mut crate::rng::SplitMix64, count: usize, flat: bool) -> Vec<Group> {
+        let point = |rng: &mut crate::rng::SplitMix64| {
+            let x = rng.below(400) as f64 * 0.25;
+            let y = if flat {
+                3.0
+            } else {
+                rng.below(400) as f64 * 0.25
+            };
+            DVec2::new(x, y)
+        };
+        (0..count)
+            .map(|k| {
+                let paths: Vec<Path> = match k % 11 {
+                    10 => Vec::new(),
+                    9 if k == 9 => vec![Path::Circle {
+                        center: DVec2::new(f64::NAN, 1.0),
+                        radius: 1.0,
+                    }],
+                    _ => (0..1 + k % 3)
+                        .map(|j| Path::Polyline {
+                            points: vec![point(rng), point(rng)],
+                            closed: (k + j) % 4 == 0,
+                        })
+                        .collect(),
+                };
+                Group {
+                    paths,
+                    last_fixed: k % 5 == 1,
+                    keep_order: k % 7 == 3,
+                }
+            })
+            .collect()
+    }
+
     #[test]
     fn the_cells_find_the_group_every_group_measured_finds() {
         let mut rng = crate::rng::SplitMix64::new(7);
-        for trial in 0..40 {
-            // Many groups on a coarse lattice, so that equal distances (ties) are common.
-            let count = 1 + trial * 7;
-            let groups: Vec<Group> = (0..count)
-                .map(|k| {
-                    let mut point = || {
-                        let mut coordinate = || rng.below(400) as f64 * 0.25;
-                        DVec2::new(coordinate(), coordinate())
-                    };
-                    let paths: Vec<Path> = (0..1 + k % 3)
-                        .map(|j| Path::Polyline {
-                            points: vec![point(), point()],
-                            closed: (k + j) % 4 == 0,
-                        })
-                        .collect();
-                    Group {
-                        paths,
-                        last_fixed: k % 5 == 1,
-                        keep_order: k % 7 == 3,
-                    }
-                })
-                .collect();
+        for trial in 0..60 {
+            let count = 1 + (trial % 30) * 7;
+            let groups = lattice_groups(&mut rng, count, trial >= 30);
             let entries = Entries::new(&groups);
             let mut left: Vec<Option<Group>> = groups.into_iter().map(Some).collect();
-            // From inside the groups' box, from outside it, then from each group's end.
+            // From outside the groups' box first, then from where each group ends.
             let mut at = DVec2::new(-50.0, 130.0);
-            for step in 0..count {
+            while let Some(expected) = nearest_by_every_group(&left, at) {
                 let found = entries.nearest(at, &left);
-                assert_eq!(
-                    found,
-                    nearest_by_every_group(&left, at),
-                    "trial {trial} step {step}"
-                );
-                let i = found.expect("groups are left");
-                at = left[i].take().unwrap().paths[0].end();
+                match found {
+                    // Groups without paths are never entered: nothing is left to run.
+                    None => {
+                        assert!(left.iter().flatten().all(|g| g.paths.is_empty()));
+                        break;
+                    }
+                    Some(i) => assert_eq!(i, expected, "trial {trial} from {at}"),
+                }
+                let group = left[expected].take().unwrap();
+                at = group.paths.first().map_or(at, |p| p.end());
             }
-            assert_eq!(entries.nearest(at, &left), None);
         }
     }
 
