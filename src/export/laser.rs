@@ -183,10 +183,7 @@ impl Entries {
             .enumerate()
             .flat_map(|(i, g)| entry_points(g).map(move |p| (i, p)))
             .collect();
-        let (lo, hi) = points.iter().fold(
-            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &(_, p)| (lo.min(p), hi.max(p)),
-        );
+        let (lo, hi) = crate::plane::bounds(points.iter().map(|&(_, p)| p));
         let size = (hi - lo).max(DVec2::splat(1e-9));
         // About one point a cell.
         let cell = (size.x * size.y / points.len().max(1) as f64)
