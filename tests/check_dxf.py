@@ -195,7 +195,8 @@ def main():
             fail(f"unexpected entity type {t} on layer {layer} (only POLYLINE, LINE, CIRCLE allowed)")
         out.append(item)
 
-    json.dump(out, sys.stdout)
+    # One string: json.dump streams through the pure-Python encoder, dumps uses the C one.
+    sys.stdout.write(json.dumps(out))
     sys.stdout.write("\n")
 
 

@@ -494,9 +494,12 @@ pub fn read_dxf_with_ezdxf(path: &Path) -> Result<Vec<DxfEntity>, String> {
     let script = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("tests")
         .join("check_dxf.py");
+    // ezdxf imports numpy, whose OpenBLAS otherwise starts a spinning thread per core
+    // in every check: a share of the suite's time for no work.
     let out = Command::new("python3")
         .arg(&script)
         .arg(path)
+        .env("OPENBLAS_NUM_THREADS", "1")
         .output()
         .map_err(|e| format!("cannot run python3 for tests/check_dxf.py: {e}"))?;
     let stderr = String::from_utf8_lossy(&out.stderr).trim().to_string();
