@@ -473,7 +473,10 @@ pub fn nest(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Neste
     let nested =
         lay_out_observed(&outlines, &areas, sheet, &job.nest, &progress).map_err(too_large)?;
     let mut notes = Vec::new();
-    if let Some(searched) = nested.dropped_search_sheets {
+    let dropped = nested
+        .search_phases
+        .filter(|_| nested.nester == crate::nest::NesterName::Shelf);
+    if let Some(searched) = dropped.map(|p| p.squeezed) {
         notes.push(format!(
             "the true-shape search needed {searched} sheets and the shelf layout {}: the shelf layout is used",
             nested.shelf_sheets
@@ -488,6 +491,7 @@ pub fn nest(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Neste
         mirror: search.mirror,
         time_limit: search.time_limit.map(|t| t.as_secs_f64()),
         shelf_sheets: nested.shelf_sheets,
+        search_sheets: nested.search_phases,
     };
     Ok(Nested {
         layout: nested.layout,

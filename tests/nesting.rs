@@ -243,6 +243,7 @@ fn trapezoids_alternate() {
 #[test]
 fn true_shapes_need_fewer_sheets_than_shelves_on_small_models() {
     let tmp = TempDir::new().unwrap();
+    let mut saved = false;
     for name in ["icosahedron", "concave"] {
         let shelf_out = tmp.path().join(format!("{name}-shelf"));
         let shelf = build(
@@ -271,7 +272,25 @@ fn true_shapes_need_fewer_sheets_than_shelves_on_small_models() {
             count(&shelf, "counts.sheets")
         );
         assert!(run.stderr.contains("each sheet filled"), "{}", run.stderr);
+        // The search's sheets after each phase: the last is the layout's, and a
+        // phase that saved sheets is in the report.
+        assert!(shelf["nesting"].get("search_sheets").is_none());
+        let phase = |p: &str| count(&m, &format!("nesting.search_sheets.{p}"));
+        let (placed, moved, squeezed) = (phase("placed"), phase("moved"), phase("squeezed"));
+        assert_eq!(squeezed, sheets, "{name}");
+        assert!(
+            placed >= moved && moved >= squeezed,
+            "{name}: {placed} {moved} {squeezed}"
+        );
+        let said = run.stderr.contains("after moving parts");
+        assert_eq!(said, squeezed < placed, "{name}: {}", run.stderr);
+        let line = format!(
+            "{placed} sheets placed, {moved} after moving parts, {squeezed} after squeezing;"
+        );
+        assert!(!said || run.stderr.contains(&line), "{}", run.stderr);
+        saved |= squeezed < placed;
     }
+    assert!(saved, "no model's search saved a sheet after placing");
 }
 
 #[test]

@@ -104,6 +104,10 @@ pub struct Nesting {
     pub time_limit: Option<f64>,
     /// Sheets the shelf baseline needs for the same panels.
     pub shelf_sheets: usize,
+    /// The true-shape search's sheets after its construction, its moves and its
+    /// squeeze; absent when it did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search_sheets: Option<crate::nest::true_shape::PhaseSheets>,
 }
 
 /// Counts.

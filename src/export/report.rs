@@ -32,6 +32,20 @@ pub(super) fn duration(seconds: f64) -> String {
     }
 }
 
+/// " 28 sheets placed, 27 after moving parts, 26 after squeezing;" when the true-shape
+/// search's later phases saved sheets (whether more effort may pay); else nothing.
+fn search_savings(nesting: &super::manifest::Nesting) -> String {
+    match nesting.search_sheets {
+        Some(p) if nesting.nester == "true-shape" && p.squeezed < p.placed => format!(
+            " {} placed, {} after moving parts, {} after squeezing;",
+            crate::units::count_of(p.placed, "sheet"),
+            p.moved,
+            p.squeezed
+        ),
+        _ => String::new(),
+    }
+}
+
 /// The report's lines on the laser: path lengths and folds, the kerf, the time.
 fn laser_lines(s: &mut String, m: &Manifest) {
     use std::fmt::Write;
@@ -117,10 +131,11 @@ pub fn text(m: &Manifest, extras: &Extras, out: &Path) -> String {
         .collect();
     let _ = writeln!(
         s,
-        "layout: {} (effort {}, seed {}), each sheet filled {}; laying bounding boxes in rows would take {}",
+        "layout: {} (effort {}, seed {}),{} each sheet filled {}; laying bounding boxes in rows would take {}",
         m.nesting.nester,
         m.nesting.effort,
         m.nesting.seed,
+        search_savings(&m.nesting),
         fills.join(" "),
         crate::units::count_of(m.nesting.shelf_sheets, "sheet")
     );

@@ -153,8 +153,9 @@ pub struct Nested {
     pub nester: NesterName,
     /// Sheets of the shelf baseline for the same parts.
     pub shelf_sheets: usize,
-    /// Sheets of the true-shape search when its result was dropped for the shelf's.
-    pub dropped_search_sheets: Option<usize>,
+    /// The true-shape search's sheets after each phase, when it ran (its result is
+    /// dropped for the shelf's when that takes fewer sheets).
+    pub search_phases: Option<true_shape::PhaseSheets>,
     /// The lower bound that counts the spacing ([`spacing_lower_bound`]).
     pub spacing_bound: usize,
 }
@@ -188,19 +189,19 @@ pub fn lay_out_observed(
 ) -> Result<Nested, TooLarge> {
     let shelf = shelf::shelf_layout(outlines, sheet, settings.search.rotations)?;
     let shelf_sheets = shelf.sheets;
-    let (mut layout, nester, dropped_search_sheets) = match settings.nester {
+    let (mut layout, nester, search_phases) = match settings.nester {
         NesterName::Shelf => (shelf, NesterName::Shelf, None),
         NesterName::TrueShape => {
-            let searched = true_shape::true_shape_layout_observed(
+            let (searched, phases) = true_shape::true_shape_layout_observed(
                 outlines,
                 sheet,
                 &settings.search,
                 progress,
             )?;
             if shelf.sheets < searched.sheets {
-                (shelf, NesterName::Shelf, Some(searched.sheets))
+                (shelf, NesterName::Shelf, Some(phases))
             } else {
-                (searched, NesterName::TrueShape, None)
+                (searched, NesterName::TrueShape, Some(phases))
             }
         }
     };
@@ -209,7 +210,7 @@ pub fn lay_out_observed(
         layout,
         nester,
         shelf_sheets,
-        dropped_search_sheets,
+        search_phases,
         spacing_bound: spacing_lower_bound(outlines, sheet),
     })
 }

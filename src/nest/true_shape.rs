@@ -213,6 +213,18 @@ struct Nester<'a> {
 /// improvement the rest: about their shares of its time at the default effort.
 const CONSTRUCTION_SHARE: u32 = 400;
 
+/// The sheets of the kept search after each phase: what moving parts and squeezing
+/// saved, for the manifest and the report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct PhaseSheets {
+    /// After its construction.
+    pub placed: usize,
+    /// After the moves that empty the emptiest sheet.
+    pub moved: usize,
+    /// After the squeeze (the search's result).
+    pub squeezed: usize,
+}
+
 /// Lays out parts (outer outlines in mm) by their true shapes.
 pub fn true_shape_layout(
     outlines: &[Vec<DVec2>],
@@ -220,15 +232,17 @@ pub fn true_shape_layout(
     options: &NestOptions,
 ) -> Result<Layout, TooLarge> {
     true_shape_layout_observed(outlines, sheet, options, &NestProgress::new(&|_| {}))
+        .map(|(layout, _)| layout)
 }
 
-/// [`true_shape_layout`], telling `progress` how far each search has got.
+/// [`true_shape_layout`], telling `progress` how far each search has got, with the
+/// sheets after each phase.
 pub fn true_shape_layout_observed(
     outlines: &[Vec<DVec2>],
     sheet: SheetSpec,
     options: &NestOptions,
     progress: &NestProgress,
-) -> Result<Layout, TooLarge> {
+) -> Result<(Layout, PhaseSheets), TooLarge> {
     let (parts, container) = prepare(outlines, sheet, options)?;
     // Two constructions, each improved on its own, and the better kept: rows of
     // interlocking parts win on alike parts and long strips, first-fit decreasing on
@@ -240,7 +254,7 @@ pub fn true_shape_layout_observed(
     // improvements and the squeeze: `time_limit` caps them together, on one thread
     // (where the two improvements run one after the other) as on two.
     let started = Instant::now();
-    let built = |in_rows: bool| -> Result<Nester, usize> {
+    let built = |in_rows: bool| -> Result<(Nester, usize), usize> {
         let mut nester = Nester::new(&parts, container.clone(), options);
         nester.progress = Some((progress, usize::from(in_rows)));
         if in_rows {
@@ -248,8 +262,9 @@ pub fn true_shape_layout_observed(
         } else {
             nester.construct_first_fit()?;
         }
+        let placed = nester.sheets.len();
         nester.improve(options, started);
-        Ok(nester)
+        Ok((nester, placed))
     };
     let (first_fit, rows) = rayon::join(|| built(false), || built(true));
     let too_large_part = |p: usize| too_large(p, &outlines[p], sheet, options.rotations);
@@ -257,11 +272,12 @@ pub fn true_shape_layout_observed(
         first_fit.map_err(too_large_part)?,
         rows.map_err(too_large_part)?,
     );
-    let mut nester = if rows.better_than(&first_fit) {
+    let (mut nester, placed) = if rows.0.better_than(&first_fit.0) {
         rows
     } else {
         first_fit
     };
+    let moved = nester.sheets.len();
     let effort = options.effort.max(1) as usize;
 
     // Then squeeze the emptiest sheet's parts into the others by overlap
@@ -280,7 +296,12 @@ pub fn true_shape_layout_observed(
     {}
     nester.report(0, 1000, 1, 1);
 
-    Ok(nester.finish(outlines.len(), sheet))
+    let phases = PhaseSheets {
+        placed,
+        moved,
+        squeezed: nester.sheets.len(),
+    };
+    Ok((nester.finish(outlines.len(), sheet), phases))
 }
 
 /// The collision container of a sheet and the collision items of the parts, or the
