@@ -21,7 +21,7 @@ use crate::mesh::planarize::{planarize, PlanarizeOptions, PlanarizeReport};
 use crate::mesh::split::{faces_to_split, split_faces};
 use crate::mesh::FaceId;
 
-use crate::nest::{lay_out_observed, Layout, SheetSpec};
+use crate::nest::{lay_out_observed, Layout, NesterName, SheetSpec};
 use crate::panel::{Covers, FlatPanelRef, FlatPanels, FoldKind};
 use crate::plane::is_simple;
 use crate::scheme::SchemeOutput;
@@ -473,13 +473,11 @@ pub fn nest(job: &Job, flat: &Flat, done: &(dyn Fn(f64) + Sync)) -> Result<Neste
     let nested =
         lay_out_observed(&outlines, &areas, sheet, &job.nest, &progress).map_err(too_large)?;
     let mut notes = Vec::new();
-    let dropped = nested
-        .search_phases
-        .filter(|_| nested.nester == crate::nest::NesterName::Shelf);
-    if let Some(searched) = dropped.map(|p| p.squeezed) {
+    // The search ran but the shelf layout was kept: it took fewer sheets.
+    if let (NesterName::Shelf, Some(searched)) = (nested.nester, nested.search_phases) {
         notes.push(format!(
-            "the true-shape search needed {searched} sheets and the shelf layout {}: the shelf layout is used",
-            nested.shelf_sheets
+            "the true-shape search needed {} sheets and the shelf layout {}: the shelf layout is used",
+            searched.squeezed, nested.shelf_sheets
         ));
     }
     let search = &job.nest.search;

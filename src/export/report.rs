@@ -35,8 +35,9 @@ pub(super) fn duration(seconds: f64) -> String {
 /// " 28 sheets placed, 27 after moving parts, 26 after squeezing;" when the true-shape
 /// search's later phases saved sheets (whether more effort may pay); else nothing.
 fn search_savings(nesting: &super::manifest::Nesting) -> String {
+    use crate::nest::NesterName::TrueShape;
     match nesting.search_sheets {
-        Some(p) if nesting.nester == "true-shape" && p.squeezed < p.placed => format!(
+        Some(p) if nesting.nester == TrueShape.as_str() && p.squeezed < p.placed => format!(
             " {} placed, {} after moving parts, {} after squeezing;",
             crate::units::count_of(p.placed, "sheet"),
             p.moved,
