@@ -78,6 +78,9 @@ pub fn load_model(
             kind: "simplified",
             message,
         });
+        if settings.keep_unsimplified && report.before != report.after {
+            prepared.unsimplified = Some(mesh::simplify::surface_triangles(&prepared.mesh));
+        }
         prepared.mesh = simplified;
     }
     Ok((raw, prepared))

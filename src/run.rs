@@ -253,6 +253,9 @@ pub struct Prepared {
     pub notes: Vec<String>,
     /// Findings about the build's size, each naming its fix.
     pub warnings: Vec<String>,
+    /// The surface before simplifying, in millimetres, where the scheme keeps a
+    /// distance to it ([`crate::mesh::PreparedModel::unsimplified`]).
+    pub unsimplified: Option<Vec<[glam::DVec3; 3]>>,
     /// Whether `--weld` would join vertices the model keeps apart.
     can_weld: bool,
     /// The budget the warnings suggest, once one needed it.
@@ -333,7 +336,15 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
         .notes
         .iter()
         .any(|n| n.kind == "shared-positions");
+    let unsimplified = loaded.prepared.unsimplified;
     let scheme_mesh = scheme_mesh(job, &loaded.raw, loaded.prepared.mesh)?;
+    let mm_per_unit = scheme_mesh.mm_per_unit;
+    let unsimplified = unsimplified.map(|triangles| {
+        triangles
+            .into_iter()
+            .map(|t| t.map(|p| p * mm_per_unit))
+            .collect()
+    });
     let split = &scheme_mesh.split;
     if let Some(report) = scheme_mesh
         .planarized
@@ -370,6 +381,7 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
         topology,
         notes,
         warnings,
+        unsimplified,
         can_weld,
         clean_budget: std::cell::OnceCell::new(),
     })
@@ -377,10 +389,12 @@ pub fn prepare(job: &Job, loaded: Loaded) -> Result<Prepared> {
 
 /// Stage 3, scheme: the job's scheme builds the 3D panels.
 pub fn scheme(job: &Job, prepared: &Prepared) -> Result<SchemeOutput> {
-    let output = job
-        .scheme
-        .build(&prepared.scheme_mesh.mesh)
-        .map_err(|e| scheme_error(job, e))?;
+    let mesh = &prepared.scheme_mesh.mesh;
+    let output = match &prepared.unsimplified {
+        Some(unsimplified) => job.scheme.build_near(mesh, unsimplified),
+        None => job.scheme.build(mesh),
+    }
+    .map_err(|e| scheme_error(job, e))?;
     crate::memory::release_freed();
     Ok(output)
 }

@@ -511,3 +511,54 @@ fn strips_too_narrow_for_their_ids_warn_with_a_bound_that_gives_them_room() {
         "--max-deviation {bound}"
     );
 }
+
+#[test]
+fn a_simplified_model_keeps_the_bound_to_the_model_as_given() {
+    // A fine torus simplified to 5,000 edges strays about a millimetre from itself:
+    // strips within 1 % of the simplified mesh would stray beyond 1 % of the torus
+    // as given, so they are kept within less of the simplified mesh.
+    let tmp = TempDir::new().unwrap();
+    let model = torus(tmp.path(), 96, 48, 80.0, 30.0);
+    let out = tmp.path().join("out");
+    let args = ["--target-edges", "5000", "--max-deviation", "1%"];
+    let m = build("strip", &model, "2ft", &out, &args);
+    let bound = num(&m, "strip.max_deviation");
+    // Measured here: the assembled strips against the file as given, both ways.
+    let mm = num(&m, "scheme.params.mm_per_model_unit");
+    let (points, faces) = read_simple_obj(&model);
+    let fans = |points: &[DVec3], faces: &[Vec<usize>], scale: f64| -> Vec<[DVec3; 3]> {
+        faces
+            .iter()
+            .flat_map(|f| (1..f.len() - 1).map(move |k| [f[0], f[k], f[k + 1]]))
+            .map(|t| t.map(|i| points[i] * scale))
+            .collect()
+    };
+    let given = fans(&points, &faces, mm);
+    let (points, faces) = read_simple_obj(&out.join("torus-assembled.obj"));
+    let strips = fans(&points, &faces, 1.0);
+    let spacing = bound / 4.0;
+    let away = one_way(&strips, &given, spacing, 2.0 * bound);
+    let back = one_way(&given, &strips, spacing, 2.0 * bound);
+    eprintln!("simplified torus: strips {away:.3} mm from it, it {back:.3} mm from them (bound {bound:.3} mm)");
+    assert!(away <= bound, "strips {away} mm from the torus as given");
+    assert!(
+        back <= bound,
+        "the torus as given {back} mm from the strips"
+    );
+    let within = num(&m, "strip.simplified_bound");
+    assert!(
+        within < bound,
+        "the strips are kept within {within} mm of the simplified mesh, not less than the bound {bound} mm"
+    );
+    assert!(num(&m, "strip.simplified_deviation") <= within);
+    assert!(num(&m, "strip.measured_deviation") <= bound);
+    // Without simplifying there is no second bound.
+    let whole = build(
+        "strip",
+        &model,
+        "2ft",
+        &tmp.path().join("whole"),
+        &args[2..],
+    );
+    assert!(whole["strip"].get("simplified_bound").is_none());
+}

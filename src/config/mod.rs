@@ -315,6 +315,10 @@ pub struct ModelSettings {
     pub min_component: usize,
     /// Close every boundary loop (a face along its rim; open seams joined shut).
     pub fill_holes: bool,
+    /// Keep the surface as it was before simplifying
+    /// ([`crate::mesh::PreparedModel::unsimplified`]): the job's scheme keeps a
+    /// distance to the model as given.
+    pub keep_unsimplified: bool,
 }
 
 impl ModelOptions {
@@ -387,6 +391,7 @@ impl ModelOptions {
             weld: self.weld,
             planarity_tol,
             fill_holes: self.fill_holes,
+            keep_unsimplified: false,
         })
     }
 }
@@ -852,7 +857,10 @@ impl BuildOptions {
                 None => Speeds::default(),
             },
             model_path: model_path.to_path_buf(),
-            model: self.model.resolve()?,
+            model: ModelSettings {
+                keep_unsimplified: options.bounds_distance(),
+                ..self.model.resolve()?
+            },
             scheme: ConfiguredScheme {
                 scheme,
                 options: options.into(),

@@ -50,6 +50,9 @@ pub struct PreparedModel {
     pub notes: Vec<Note>,
     /// Named groups of the input.
     pub groups: Vec<Group>,
+    /// The surface before simplifying (after repairs), as triangles in model units:
+    /// kept when simplified and asked for (`ModelSettings::keep_unsimplified`).
+    pub unsimplified: Option<Vec<[glam::DVec3; 3]>>,
 }
 
 /// How many elements a note names before it says "and N more".
@@ -109,6 +112,7 @@ pub fn prepare(raw: &RawModel, options: &PrepareOptions) -> Result<PreparedModel
         welded: welded_facts,
         notes,
         groups: raw.groups.clone(),
+        unsimplified: None,
     })
 }
 

@@ -236,6 +236,16 @@ fn unchanged(mesh: &Mesh, before: &Topology) -> (Mesh, SimplifyReport) {
     (mesh.clone(), report)
 }
 
+/// The triangles of `mesh` as the simplifier sees them (its faces split as
+/// [`triangle_indices`] splits them), by their corners' positions.
+pub fn surface_triangles(mesh: &Mesh) -> Vec<[glam::DVec3; 3]> {
+    let positions = mesh.positions();
+    triangle_indices(mesh)
+        .chunks_exact(3)
+        .map(|t| [0, 1, 2].map(|k| positions[t[k] as usize]))
+        .collect()
+}
+
 /// The mesh's faces as a triangle index list, as the simplifier works on triangles:
 /// larger faces are split (the same triangulation the schemes use for non-planar
 /// faces).

@@ -106,6 +106,23 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     fn larger_panels(&self, _mesh: &Mesh, _fits: &dyn Fn(&SchemeOutput) -> bool) -> Option<String> {
         None
     }
+    /// True when the scheme keeps its panels within a distance of the model (the strip
+    /// scheme's `--max-deviation`): a model simplified for it keeps its surface as it
+    /// was, and [`Configured::build_near`] measures the distance to that.
+    fn bounds_distance(&self) -> bool {
+        false
+    }
+    /// Builds the panels of `mesh`, simplified from `unsimplified` (the model's surface
+    /// before simplifying, triangles in millimetres): a scheme with a distance bound
+    /// keeps it to the model as given, not only to the simplified mesh. Others build
+    /// `mesh`.
+    fn build_near(
+        &self,
+        mesh: &Mesh,
+        _unsimplified: &[[DVec3; 3]],
+    ) -> Result<SchemeOutput, SchemeError> {
+        self.build(mesh)
+    }
 }
 
 /// The concrete options behind a [`Configured`], for callers that know their type
@@ -382,6 +399,21 @@ impl ConfiguredScheme {
     /// Builds the panels of `mesh`.
     pub fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
         self.options.build(mesh)
+    }
+
+    /// Builds the panels of `mesh`, simplified from `unsimplified`
+    /// ([`Configured::build_near`]).
+    pub fn build_near(
+        &self,
+        mesh: &Mesh,
+        unsimplified: &[[DVec3; 3]],
+    ) -> Result<SchemeOutput, SchemeError> {
+        self.options.build_near(mesh, unsimplified)
+    }
+
+    /// True when its panels keep a distance bound ([`Configured::bounds_distance`]).
+    pub fn bounds_distance(&self) -> bool {
+        self.options.bounds_distance()
     }
 
     /// The least fold (radians) scored on its panels.

@@ -206,7 +206,19 @@ impl Configured for StripOptions {
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
-        strip_panels(mesh, self)
+        strip_panels(mesh, self, None)
+    }
+
+    fn bounds_distance(&self) -> bool {
+        true
+    }
+
+    fn build_near(
+        &self,
+        mesh: &Mesh,
+        unsimplified: &[[DVec3; 3]],
+    ) -> Result<SchemeOutput, SchemeError> {
+        strip_panels(mesh, self, Some(unsimplified))
     }
 
     fn params(&self) -> Params {
@@ -241,17 +253,21 @@ impl Configured for StripOptions {
                 max_deviation: self.max_deviation.times(k),
                 ..self.clone()
             };
-            let output = strip_panels(mesh, &wider).ok()?;
+            let output = strip_panels(mesh, &wider, None).ok()?;
             fits(&output).then(|| format!("--max-deviation {}", wider.max_deviation))
         })
     }
 }
 
 /// The strips of `mesh` within the bound, welded into one surface and cut into pieces
-/// with tabs.
-fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, SchemeError> {
+/// with tabs. When `mesh` was simplified from `unsimplified`, the bound holds to that.
+fn strip_panels(
+    mesh: &Mesh,
+    options: &StripOptions,
+    unsimplified: Option<&[[DVec3; 3]]>,
+) -> Result<SchemeOutput, SchemeError> {
     let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
-    let tolerance = options.max_deviation.length((hi - lo).length());
+    let bound = options.max_deviation.length((hi - lo).length());
     let surface = Triangles::from_mesh(mesh);
     let field = evened(
         &surface,
@@ -264,8 +280,92 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
         .panel
         .panel_limit
         .map_or(f64::INFINITY, |limit| limit.width.min(limit.height));
+    let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length);
+    let (covered, measured) = match unsimplified {
+        None => {
+            let covered = cover(bound)?;
+            let measured = covered.banded.deviation;
+            (covered, measured)
+        }
+        Some(unsimplified) => {
+            let simplified: Vec<[DVec3; 3]> = surface
+                .corners
+                .iter()
+                .map(|t| t.map(|i| surface.points[i as usize]))
+                .collect();
+            within_unsimplified(bound, &simplified, unsimplified, &cover)?
+        }
+    };
+    let Covering {
+        banded,
+        welded,
+        whole_bands,
+        tolerance,
+    } = covered;
+    // Each curve's tabs on the strip below it: the strip above is glued over them.
+    let tab_first = |h: HalfedgeId| {
+        let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
+        strip(h) <= strip(h.twin())
+    };
+    let net = clear_pieces(&welded, &options.net, &tab_first);
+    let mut output = net.output;
+    let pieces = output.panels.len();
+    output.report = vec![match unsimplified {
+        None => format!(
+            "strip: {} strips in {pieces} pieces, at most {measured:.2} mm from the model both ways as measured (bound {bound:.2} mm); each piece unrolls exactly",
+            welded.strips
+        ),
+        Some(_) => format!(
+            "strip: {} strips in {pieces} pieces, at most {measured:.2} mm from the model as given (before simplifying) both ways as measured (bound {bound:.2} mm; within {:.2} mm of the simplified model); each piece unrolls exactly",
+            welded.strips, banded.deviation
+        ),
+    }];
+    if tolerance < bound {
+        output.notes.push(format!(
+            "the strips are kept within {tolerance:.2} mm of the simplified model, not {bound:.2}: the simplification strays from the model too, and the bound holds to the model as given (a larger --target-edges, or none, gives wider strips)"
+        ));
+    }
+    if whole_bands {
+        output.report.push(format!(
+            "strip: bands run whole round the model, not cut into sectors {sector_length:.0} mm long (strips of neighbouring bands overlapped)"
+        ));
+    }
+    output
+        .report
+        .extend(net.summary.report("strip pieces", "pieces"));
+    let mut section = net.summary.section("pieces");
+    section["strips"] = welded.strips.into();
+    section["max_deviation"] = round4(bound).into();
+    section["measured_deviation"] = round4(measured).into();
+    if unsimplified.is_some() {
+        section["simplified_bound"] = round4(tolerance).into();
+        section["simplified_deviation"] = round4(banded.deviation).into();
+    }
+    output.manifest.push("strip", section);
+    output.surface = Some(welded.mesh);
+    Ok(output)
+}
+
+/// The strips of a surface within a tolerance, welded.
+struct Covering {
+    banded: Banded,
+    welded: Welded,
+    /// Bands were kept whole: their sectors' strips overlapped.
+    whole_bands: bool,
+    /// The tolerance the strips were kept within.
+    tolerance: f64,
+}
+
+/// The strips of `surface` within `tolerance` ([`strips_within`]), welded into one
+/// surface; where the sectors' strips of neighbouring bands overlap, every band whole.
+fn covering(
+    surface: &Triangles,
+    field: &[f64],
+    tolerance: f64,
+    sector_length: f64,
+) -> Result<Covering, SchemeError> {
     let within = |sector_length: f64| {
-        strips_within(&surface, &field, tolerance, sector_length).map_err(|e| {
+        strips_within(surface, field, tolerance, sector_length).map_err(|e| {
             SchemeError::Model(format!(
                 "no strips within {tolerance:.3} mm of the model: {e}; a larger --max-deviation may reach"
             ))
@@ -280,34 +380,70 @@ fn strip_panels(mesh: &Mesh, options: &StripOptions) -> Result<SchemeOutput, Sch
         banded = within(f64::INFINITY)?;
         welded = Welded::new(&banded.strips);
     }
-    let welded = welded.map_err(SchemeError::Model)?;
-    // Each curve's tabs on the strip below it: the strip above is glued over them.
-    let tab_first = |h: HalfedgeId| {
-        let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
-        strip(h) <= strip(h.twin())
+    Ok(Covering {
+        welded: welded.map_err(SchemeError::Model)?,
+        banded,
+        whole_bands,
+        tolerance,
+    })
+}
+
+/// How much further than the estimate of what the strips strayed the second try
+/// narrows them: the narrower strips' worst point moves.
+const NARROWER_MARGIN: f64 = 1.5;
+
+/// Strips within `bound` of `unsimplified` both ways, with the largest distance
+/// measured. They are first kept within `bound` of the simplified mesh (`cover`); the
+/// simplification's own error adds to theirs, so where they stray further from the
+/// model as given, they are kept within less by what they strayed (sampled finely,
+/// with a margin), and where that is not enough, within the bound less the largest
+/// distance between `simplified` and `unsimplified`, which the triangle inequality
+/// makes enough.
+fn within_unsimplified(
+    bound: f64,
+    simplified: &[[DVec3; 3]],
+    unsimplified: &[[DVec3; 3]],
+    cover: &dyn Fn(f64) -> Result<Covering, SchemeError>,
+) -> Result<(Covering, f64), SchemeError> {
+    let spacing = bound / 3.0;
+    let both_ways = |a: &[[DVec3; 3]], b: &[[DVec3; 3]], fine: bool| {
+        let one_way = |from: &[[DVec3; 3]], to: &[[DVec3; 3]]| {
+            if fine {
+                one_way_distance(from, to, spacing / 4.0)
+            } else {
+                distance_beyond(from, to, spacing, bound, f64::INFINITY)
+            }
+        };
+        let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
+        out.max(back)
     };
-    let net = clear_pieces(&welded, &options.net, &tab_first);
-    let mut output = net.output;
-    let pieces = output.panels.len();
-    output.report = vec![format!(
-        "strip: {} strips in {pieces} pieces, at most {:.2} mm from the model both ways as measured (bound {:.2} mm); each piece unrolls exactly",
-        welded.strips, banded.deviation, tolerance
-    )];
-    if whole_bands {
-        output.report.push(format!(
-            "strip: bands run whole round the model, not cut into sectors {sector_length:.0} mm long (strips of neighbouring bands overlapped)"
-        ));
+    let first = cover(bound)?;
+    let soup = strip_soup(&first.banded.strips);
+    let measured = both_ways(&soup, unsimplified, false);
+    if measured <= bound {
+        return Ok((first, measured));
     }
-    output
-        .report
-        .extend(net.summary.report("strip pieces", "pieces"));
-    let mut section = net.summary.section("pieces");
-    section["strips"] = welded.strips.into();
-    section["max_deviation"] = round4(tolerance).into();
-    section["measured_deviation"] = round4(banded.deviation).into();
-    output.manifest.push("strip", section);
-    output.surface = Some(welded.mesh);
-    Ok(output)
+    let strayed = both_ways(&soup, unsimplified, true).max(bound);
+    let simplification = both_ways(simplified, unsimplified, false);
+    let assured = bound - simplification;
+    if assured <= 0.0 {
+        return Err(SchemeError::Options(format!(
+            "the simplified model strays up to {simplification:.2} mm from the model as given, beyond --max-deviation ({bound:.2} mm): simplify less (a larger --target-edges) or allow more (a larger --max-deviation)"
+        )));
+    }
+    let narrower = bound - NARROWER_MARGIN * (strayed - bound);
+    if narrower > assured {
+        let second = cover(narrower)?;
+        let soup = strip_soup(&second.banded.strips);
+        let measured = both_ways(&soup, unsimplified, false);
+        if measured <= bound {
+            return Ok((second, measured));
+        }
+    }
+    let last = cover(assured)?;
+    let soup = strip_soup(&last.banded.strips);
+    let measured = both_ways(&soup, unsimplified, false);
+    Ok((last, measured))
 }
 
 /// The pieces: islands grown along the strips' rungs, in order. A piece whose outline,
