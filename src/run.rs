@@ -309,6 +309,8 @@ fn model_at(job: &Job, edges: usize, repairs: crate::sanity::Repairs) -> Option<
 /// The model of `trial` repaired as `repairs` say (on top of its own options), scaled
 /// and split for the scheme.
 fn repaired(mut trial: Job, repairs: crate::sanity::Repairs) -> Option<crate::mesh::Mesh> {
+    // A trial builds from the mesh alone.
+    trial.model.keep_unsimplified = false;
     trial.model.weld |= repairs.weld;
     trial.model.fill_holes |= repairs.fill_holes;
     let loaded = load(&trial).ok()?;

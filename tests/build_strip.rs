@@ -514,9 +514,9 @@ fn strips_too_narrow_for_their_ids_warn_with_a_bound_that_gives_them_room() {
 
 #[test]
 fn a_simplified_model_keeps_the_bound_to_the_model_as_given() {
-    // A fine torus simplified to 5,000 edges strays about a millimetre from itself:
-    // strips within 1 % of the simplified mesh would stray beyond 1 % of the torus
-    // as given, so they are kept within less of the simplified mesh.
+    // A fine torus simplified to 5,000 edges lies about a millimetre from the torus
+    // as given: strips within 1 % of the simplified mesh would stray beyond 1 % of
+    // the torus as given, so they are kept within less of the simplified mesh.
     let tmp = TempDir::new().unwrap();
     let model = torus(tmp.path(), 96, 48, 80.0, 30.0);
     let out = tmp.path().join("out");
@@ -561,4 +561,31 @@ fn a_simplified_model_keeps_the_bound_to_the_model_as_given() {
         &args[2..],
     );
     assert!(whole["strip"].get("simplified_bound").is_none());
+    // Simplified to 600 edges it lies further from itself than strips could make up
+    // for: a usage error naming the fixes, nothing written.
+    let coarse = tmp.path().join("coarse");
+    let run = unfold([
+        model.to_str().unwrap(),
+        "--scheme",
+        "strip",
+        "--size",
+        "2ft",
+        "--target-edges",
+        "600",
+        "--max-deviation",
+        "1%",
+        "--out",
+        coarse.to_str().unwrap(),
+    ]);
+    assert_refusal(
+        "simplified to 600 edges",
+        &run,
+        2,
+        &[
+            "from the model as given",
+            "--target-edges",
+            "allow at least",
+        ],
+    );
+    assert!(!coarse.exists(), "nothing written");
 }

@@ -392,6 +392,11 @@ fn covering(
 /// narrows them: the narrower strips' worst point moves.
 const NARROWER_MARGIN: f64 = 1.5;
 
+/// The least share of the bound the strips may be kept within of a simplified mesh:
+/// narrower, they would be more than twice as many, and a simplification that leaves
+/// them less is named as the fault.
+const LEAST_SHARE: f64 = 0.25;
+
 /// Strips within `bound` of `unsimplified` both ways, with the largest distance
 /// measured. They are first kept within `bound` of the simplified mesh (`cover`); the
 /// simplification's own error adds to theirs, so where they stray further from the
@@ -406,43 +411,63 @@ fn within_unsimplified(
     cover: &dyn Fn(f64) -> Result<Covering, SchemeError>,
 ) -> Result<(Covering, f64), SchemeError> {
     let spacing = bound / 3.0;
-    let both_ways = |a: &[[DVec3; 3]], b: &[[DVec3; 3]], fine: bool| {
+    // A bound that holds at every point, refined until settled against `within`.
+    let beyond = |a: &[[DVec3; 3]], b: &[[DVec3; 3]], within: f64| {
         let one_way = |from: &[[DVec3; 3]], to: &[[DVec3; 3]]| {
-            if fine {
-                one_way_distance(from, to, spacing / 4.0)
-            } else {
-                distance_beyond(from, to, spacing, bound, f64::INFINITY)
-            }
+            distance_beyond(from, to, spacing, within, f64::INFINITY)
         };
         let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
         out.max(back)
     };
-    let first = cover(bound)?;
-    let soup = strip_soup(&first.banded.strips);
-    let measured = both_ways(&soup, unsimplified, false);
-    if measured <= bound {
-        return Ok((first, measured));
-    }
-    let strayed = both_ways(&soup, unsimplified, true).max(bound);
-    let simplification = both_ways(simplified, unsimplified, false);
+    // The largest distance at samples a quarter as far apart: at most the true one.
+    let sampled = |a: &[[DVec3; 3]], b: &[[DVec3; 3]]| {
+        let one_way =
+            |from: &[[DVec3; 3]], to: &[[DVec3; 3]]| one_way_distance(from, to, spacing / 4.0);
+        let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
+        out.max(back)
+    };
+    let strayed = {
+        let first = cover(bound)?;
+        let soup = strip_soup(&first.banded.strips);
+        let measured = beyond(&soup, unsimplified, bound);
+        if measured <= bound {
+            return Ok((first, measured));
+        }
+        // Where the finer samples find no point beyond the bound, the bound's own does.
+        let sampled = sampled(&soup, unsimplified);
+        if sampled > bound {
+            sampled
+        } else {
+            measured
+        }
+    };
+    // Refined against what the samples find, the bound comes close to it.
+    let simplification = beyond(
+        simplified,
+        unsimplified,
+        1.05 * sampled(simplified, unsimplified),
+    );
     let assured = bound - simplification;
-    if assured <= 0.0 {
+    if assured < LEAST_SHARE * bound {
         return Err(SchemeError::Options(format!(
-            "the simplified model strays up to {simplification:.2} mm from the model as given, beyond --max-deviation ({bound:.2} mm): simplify less (a larger --target-edges) or allow more (a larger --max-deviation)"
+            "the simplified model lies up to {simplification:.2} mm from the model as given, which leaves the strips too little of --max-deviation ({bound:.2} mm): simplify less (more --target-edges or --target-faces, or none) or allow at least {:.2} mm",
+            simplification / (1.0 - LEAST_SHARE)
         )));
     }
     let narrower = bound - NARROWER_MARGIN * (strayed - bound);
     if narrower > assured {
         let second = cover(narrower)?;
         let soup = strip_soup(&second.banded.strips);
-        let measured = both_ways(&soup, unsimplified, false);
+        let measured = beyond(&soup, unsimplified, bound);
         if measured <= bound {
             return Ok((second, measured));
         }
     }
     let last = cover(assured)?;
     let soup = strip_soup(&last.banded.strips);
-    let measured = both_ways(&soup, unsimplified, false);
+    // Both are bounds that hold at every point; the triangle inequality keeps the
+    // second within the bound.
+    let measured = beyond(&soup, unsimplified, bound).min(last.banded.deviation + simplification);
     Ok((last, measured))
 }
 
