@@ -426,20 +426,29 @@ fn within_unsimplified(
         let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
         out.max(back)
     };
-    let strayed = {
-        let first = cover(bound)?;
-        let soup = strip_soup(&first.banded.strips);
+    let first = cover(bound)?;
+    let soup = strip_soup(&first.banded.strips);
+    let measured = beyond(&soup, unsimplified, bound);
+    if measured <= bound {
+        return Ok((first, measured));
+    }
+    // Where the finer samples find no point beyond the bound, the bound's own does.
+    let strayed = match sampled(&soup, unsimplified) {
+        finer if finer > bound => finer,
+        _ => measured,
+    };
+    drop(first);
+    let narrower = bound - NARROWER_MARGIN * (strayed - bound);
+    let second = if narrower >= LEAST_SHARE * bound {
+        let second = cover(narrower)?;
+        let soup = strip_soup(&second.banded.strips);
         let measured = beyond(&soup, unsimplified, bound);
         if measured <= bound {
-            return Ok((first, measured));
+            return Ok((second, measured));
         }
-        // Where the finer samples find no point beyond the bound, the bound's own does.
-        let sampled = sampled(&soup, unsimplified);
-        if sampled > bound {
-            sampled
-        } else {
-            measured
-        }
+        Some((second, measured))
+    } else {
+        None
     };
     // Refined against what the samples find, the bound comes close to it.
     let simplification = beyond(
@@ -448,27 +457,29 @@ fn within_unsimplified(
         1.05 * sampled(simplified, unsimplified),
     );
     let assured = bound - simplification;
+    // Strips within `assured` of the simplified mesh keep the bound to the model as
+    // given (the triangle inequality), even where the measured bound, which adds the
+    // samples' reach, says a little more.
+    let kept = |covered: Covering, measured: f64| {
+        let measured = measured.min(covered.banded.deviation + simplification);
+        (covered, measured)
+    };
+    match second {
+        Some((second, measured)) if second.banded.deviation <= assured => {
+            return Ok(kept(second, measured));
+        }
+        _ => {}
+    }
     if assured < LEAST_SHARE * bound {
         return Err(SchemeError::Options(format!(
             "the simplified model lies up to {simplification:.2} mm from the model as given, which leaves the strips too little of --max-deviation ({bound:.2} mm): simplify less (more --target-edges or --target-faces, or none) or allow at least {:.2} mm",
             simplification / (1.0 - LEAST_SHARE)
         )));
     }
-    let narrower = bound - NARROWER_MARGIN * (strayed - bound);
-    if narrower > assured {
-        let second = cover(narrower)?;
-        let soup = strip_soup(&second.banded.strips);
-        let measured = beyond(&soup, unsimplified, bound);
-        if measured <= bound {
-            return Ok((second, measured));
-        }
-    }
     let last = cover(assured)?;
     let soup = strip_soup(&last.banded.strips);
-    // Both are bounds that hold at every point; the triangle inequality keeps the
-    // second within the bound.
-    let measured = beyond(&soup, unsimplified, bound).min(last.banded.deviation + simplification);
-    Ok((last, measured))
+    let measured = beyond(&soup, unsimplified, bound);
+    Ok(kept(last, measured))
 }
 
 /// The pieces: islands grown along the strips' rungs, in order. A piece whose outline,
