@@ -61,8 +61,9 @@ struct StripArgs {
     #[command(flatten)]
     flat_fold: FlatFoldArgs,
 
-    /// Largest distance between the strips and the model, both ways (strip scheme): a
-    /// length with a unit, or a percentage of the built model's bounding-box diagonal.
+    /// Largest distance between the strips and the model as given (before any
+    /// simplifying), both ways (strip scheme): a length with a unit, or a percentage of
+    /// the built model's bounding-box diagonal.
     #[arg(long, value_name = "LENGTH|P%")]
     max_deviation: Option<String>,
 }
