@@ -411,11 +411,6 @@ impl ConfiguredScheme {
         self.options.build_near(mesh, unsimplified)
     }
 
-    /// True when its panels keep a distance bound ([`Configured::bounds_distance`]).
-    pub fn bounds_distance(&self) -> bool {
-        self.options.bounds_distance()
-    }
-
     /// The least fold (radians) scored on its panels.
     pub fn least_scored_fold(&self) -> f64 {
         self.options.least_scored_fold()

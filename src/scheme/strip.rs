@@ -288,14 +288,7 @@ fn strip_panels(
             let measured = covered.banded.deviation;
             (covered, measured)
         }
-        Some(unsimplified) => {
-            let simplified: Vec<[DVec3; 3]> = surface
-                .corners
-                .iter()
-                .map(|t| t.map(|i| surface.points[i as usize]))
-                .collect();
-            within_unsimplified(bound, &simplified, unsimplified, &cover)?
-        }
+        Some(unsimplified) => within_unsimplified(bound, &surface.soup(), unsimplified, &cover)?,
     };
     let Covering {
         banded,
@@ -411,30 +404,31 @@ fn within_unsimplified(
     unsimplified: &[[DVec3; 3]],
     cover: &dyn Fn(f64) -> Result<Covering, SchemeError>,
 ) -> Result<(Covering, f64), SchemeError> {
+    type Soup<'a> = &'a [[DVec3; 3]];
     let spacing = bound / 3.0;
-    // A bound that holds at every point, refined until settled against `within`.
-    let beyond = |a: &[[DVec3; 3]], b: &[[DVec3; 3]], within: f64| {
-        let one_way = |from: &[[DVec3; 3]], to: &[[DVec3; 3]]| {
-            distance_beyond(from, to, spacing, within, f64::INFINITY)
-        };
+    // The larger of the two ways, each on its own thread.
+    let both_ways = |a: Soup, b: Soup, one_way: &(dyn Fn(Soup, Soup) -> f64 + Sync)| {
         let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
         out.max(back)
+    };
+    // A bound that holds at every point, refined until settled against `within`.
+    let beyond = |a: Soup, b: Soup, within: f64| {
+        both_ways(a, b, &|from, to| {
+            distance_beyond(from, to, spacing, within, f64::INFINITY)
+        })
     };
     // The largest distance at samples a quarter as far apart: at most the true one.
-    let sampled = |a: &[[DVec3; 3]], b: &[[DVec3; 3]]| {
-        let one_way =
-            |from: &[[DVec3; 3]], to: &[[DVec3; 3]]| one_way_distance(from, to, spacing / 4.0);
-        let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
-        out.max(back)
-    };
+    let sampled =
+        |a: Soup, b: Soup| both_ways(a, b, &|from, to| one_way_distance(from, to, spacing / 4.0));
+    let to_model =
+        |covered: &Covering| beyond(&strip_soup(&covered.banded.strips), unsimplified, bound);
     let first = cover(bound)?;
-    let soup = strip_soup(&first.banded.strips);
-    let measured = beyond(&soup, unsimplified, bound);
+    let measured = to_model(&first);
     if measured <= bound {
         return Ok((first, measured));
     }
     // Where the finer samples find no point beyond the bound, the bound's own does.
-    let strayed = match sampled(&soup, unsimplified) {
+    let strayed = match sampled(&strip_soup(&first.banded.strips), unsimplified) {
         finer if finer > bound => finer,
         _ => measured,
     };
@@ -442,8 +436,7 @@ fn within_unsimplified(
     let narrower = bound - NARROWER_MARGIN * (strayed - bound);
     let second = if narrower >= LEAST_SHARE * bound {
         let second = cover(narrower)?;
-        let soup = strip_soup(&second.banded.strips);
-        let measured = beyond(&soup, unsimplified, bound);
+        let measured = to_model(&second);
         if measured <= bound {
             return Ok((second, measured));
         }
@@ -478,8 +471,7 @@ fn within_unsimplified(
         )));
     }
     let last = cover(assured)?;
-    let soup = strip_soup(&last.banded.strips);
-    let measured = beyond(&soup, unsimplified, bound);
+    let measured = to_model(&last);
     Ok(kept(last, measured))
 }
 
