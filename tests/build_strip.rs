@@ -159,15 +159,28 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
             });
         (hi - lo).max_element()
     };
-    // Pieces by strip; every face in one piece.
-    let mut strips: BTreeMap<u32, Vec<&[u32]>> = BTreeMap::new();
+    // The faces of other strips that pieces with no room for their id joined to them.
+    let joined: BTreeMap<u32, u32> = strip_section(&p.output.manifest)["joined"]
+        .as_array()
+        .expect("strip.joined")
+        .iter()
+        .flat_map(|j| {
+            let strip = j["strip"].as_u64().unwrap() as u32;
+            let faces = j["faces"].as_array().unwrap().iter();
+            faces.map(move |f| (f.as_u64().unwrap() as u32, strip))
+        })
+        .collect();
+    // Faces by strip and pieces; every face in one piece.
+    let mut strips: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     let mut covered = BTreeSet::new();
     for (panel, group) in p.panels.iter().zip(&p.output.face_groups) {
         let id = panel.id();
         assert_eq!(id.to_string().chars().next(), Some('S'), "{what}: {id}");
-        strips.entry(id.number).or_default().push(&group.faces);
+        assert_no_interior_vertex(what, &format!("piece {id}"), surface, &group.faces);
         for &f in &group.faces {
             assert!(covered.insert(f), "{what}: face {f} in two pieces");
+            let strip = joined.get(&f).copied().unwrap_or(id.number);
+            strips.entry(strip).or_default().push(f);
         }
     }
     assert_eq!(
@@ -175,12 +188,8 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
         surface.face_count(),
         "{what}: faces in pieces"
     );
-    for (strip, pieces) in &strips {
-        let all: Vec<u32> = pieces.iter().flat_map(|f| f.iter().copied()).collect();
-        assert_no_interior_vertex(what, &format!("S{strip}"), surface, &all);
-        for faces in pieces {
-            assert_no_interior_vertex(what, &format!("a piece of S{strip}"), surface, faces);
-        }
+    for (strip, all) in &strips {
+        assert_no_interior_vertex(what, &format!("S{strip}"), surface, all);
         // A strip's faces are numbered along it: its pieces are runs.
         let mut sorted = all.clone();
         sorted.sort_unstable();
@@ -221,6 +230,18 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
         "{what}: model {back} mm from the strips"
     );
     (strips.len(), p.panels.len())
+}
+
+/// The scheme's `strip` section of the manifest.
+fn strip_section(manifest: &unfold::record::Params) -> &Value {
+    manifest
+        .0
+        .iter()
+        .find_map(|(name, field)| match field {
+            unfold::record::Field::Value(v) if name == "strip" => Some(v),
+            _ => None,
+        })
+        .expect("a strip section")
 }
 
 /// Every corner of `faces` (of `surface`, numbered along their strip) lies on their
@@ -484,6 +505,35 @@ fn strips_too_narrow_for_their_ids_warn_with_a_bound_that_gives_them_room() {
         warning.contains("strip panels have no room for their id"),
         "{warning}"
     );
+    // A strip's end with no room for its id is joined to a neighbour piece, which
+    // keeps its own name and unrolls exactly.
+    let joined = manifest["strip"]["joined"]
+        .as_array()
+        .expect("strip.joined");
+    assert!(!joined.is_empty(), "no piece joined to a neighbour");
+    for j in joined {
+        let piece = j["piece"].as_str().unwrap();
+        let panel = manifest["panels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["id"] == piece)
+            .unwrap_or_else(|| panic!("{piece} is no piece"));
+        let strip = j["strip"].as_u64().unwrap();
+        assert_ne!(panel["source"]["strip"].as_u64(), Some(strip), "{piece}");
+        let faces: Vec<&Value> = panel["source"]["faces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .collect();
+        for f in j["faces"].as_array().unwrap() {
+            assert!(faces.contains(&f), "{piece} lacks face {f} of S{strip}");
+        }
+        assert!(
+            panel["developability_error"].as_f64().unwrap() <= 1e-9,
+            "{piece}"
+        );
+    }
     let bound = warning
         .split("--max-deviation ")
         .nth(1)

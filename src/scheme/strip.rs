@@ -301,7 +301,8 @@ fn strip_panels(
         let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
         strip(h) <= strip(h.twin())
     };
-    let net = clear_pieces(&welded, &options.net, &tab_first);
+    let (net, members) = clear_pieces(&welded, &options.net, &tab_first);
+    let joined = welded.joined(&members);
     let mut output = net.output;
     let pieces = output.panels.len();
     output.report = vec![match unsimplified {
@@ -331,6 +332,17 @@ fn strip_panels(
     section["strips"] = welded.strips.into();
     section["max_deviation"] = round4(bound).into();
     section["measured_deviation"] = round4(measured).into();
+    section["joined"] = joined
+        .iter()
+        .map(|(k, strip, faces)| {
+            serde_json::json!({
+                "piece": output.panels.get(*k).id().to_string(),
+                "strip": strip,
+                "faces": faces,
+            })
+        })
+        .collect::<Vec<_>>()
+        .into();
     if unsimplified.is_some() {
         section["simplified_bound"] = round4(tolerance).into();
         section["simplified_deviation"] = round4(banded.deviation).into();
@@ -478,12 +490,16 @@ fn within_unsimplified(
 /// The pieces: islands grown along the strips' rungs, in order. A piece whose outline,
 /// tabs included, meets itself when unrolled (its faces wrap round a corner of its
 /// strip's side until two of their edges lie on one line) is cut at its middle rung
-/// and the pieces are grown again.
+/// and the pieces are grown again. A piece with no room for its id (a sliver where a
+/// strip's two curves nearly touch, or a stub at a strip's end) is joined to the
+/// neighbour piece it shares its longest edge with, or the next, as far as the join
+/// keeps that piece clear of itself and on the sheet. Returns the net and each
+/// piece's faces, in the order of its panels.
 fn clear_pieces(
     welded: &Welded,
     options: &NetOptions,
     tab_first: &dyn Fn(HalfedgeId) -> bool,
-) -> IslandNet {
+) -> (IslandNet, Vec<Vec<u32>>) {
     // The faces of each piece, in the order of the panels, as the net names them.
     let members = std::cell::RefCell::new(Vec::new());
     let names = |faces: &[Vec<u32>]| {
@@ -491,12 +507,17 @@ fn clear_pieces(
         welded.names(faces)
     };
     let mut folds = welded.folds.clone();
+    // Each piece without room for its id, by its lowest face: the edges it may join a
+    // neighbour along, longest first, and which of them is tried.
+    let mut joins: BTreeMap<u32, (Vec<EdgeId>, usize)> = BTreeMap::new();
     loop {
         let own = OwnNet {
             names: &names,
             tab_first,
         };
-        let net = islands_along(&welded.mesh, options, &folds, &IslandNames::Own(own));
+        let mut along = folds.clone();
+        along.extend(joins.values().filter_map(|(edges, k)| edges.get(*k)));
+        let net = islands_along(&welded.mesh, options, &along, &IslandNames::Own(own));
         let faces_of = members.borrow();
         let cut = net.output.panels.iter().enumerate().find_map(|(k, panel)| {
             let flat = crate::flatten::flatten(panel).ok()?;
@@ -505,11 +526,78 @@ fn clear_pieces(
             }
             middle_rung(&welded.mesh, &faces_of[k], &folds)
         });
-        match cut {
-            Some(rung) => folds.retain(|&e| e != rung),
-            None => return net,
+        if let Some(rung) = cut {
+            folds.retain(|&e| e != rung);
+            continue;
+        }
+        if !next_joins(&welded.mesh, &net.output, &faces_of, &mut joins) {
+            let faces_of = faces_of.clone();
+            return (net, faces_of);
         }
     }
+}
+
+/// Updates the joins of pieces with no room for their id (`joins`, see
+/// [`clear_pieces`]) after a net was grown with them: a piece still without room
+/// tries its next edge, a new one its first. False when nothing changed.
+fn next_joins(
+    mesh: &Mesh,
+    output: &SchemeOutput,
+    faces_of: &[Vec<u32>],
+    joins: &mut BTreeMap<u32, (Vec<EdgeId>, usize)>,
+) -> bool {
+    let labels = crate::labels::LabelOptions::default();
+    let roomless: Vec<bool> = (0..output.panels.len())
+        .into_par_iter()
+        .map(|k| {
+            crate::flatten::unroll_and_fit(output.panels.get(k), labels)
+                .is_ok_and(|(_, left)| left.panel > 0)
+        })
+        .collect();
+    let mut piece_of = vec![usize::MAX; mesh.face_count()];
+    for (k, faces) in faces_of.iter().enumerate() {
+        for &f in faces {
+            piece_of[f as usize] = k;
+        }
+    }
+    let mut changed = false;
+    for (k, faces) in faces_of.iter().enumerate() {
+        if !roomless[k] {
+            continue;
+        }
+        let tried = joins
+            .iter_mut()
+            .find(|(first, _)| piece_of[**first as usize] == k);
+        match tried {
+            Some((_, (edges, next))) if *next + 1 < edges.len() => {
+                *next += 1;
+                changed = true;
+            }
+            Some(_) => {}
+            None => {
+                let edges = joining_edges(mesh, faces, &|f| !roomless[piece_of[f as usize]]);
+                changed |= !edges.is_empty();
+                joins.insert(faces[0], (edges, 0));
+            }
+        }
+    }
+    changed
+}
+
+/// The edges between `faces` and faces of other pieces that have room for their id
+/// (`roomy`), longest first.
+fn joining_edges(mesh: &Mesh, faces: &[u32], roomy: &dyn Fn(u32) -> bool) -> Vec<EdgeId> {
+    let mut edges: Vec<(f64, EdgeId)> = faces
+        .iter()
+        .flat_map(|&f| mesh.face_half_edges(FaceId(f)))
+        .filter_map(|h| {
+            let across = mesh.face(h.twin())?;
+            (!faces.contains(&across.0) && roomy(across.0))
+                .then(|| (mesh.edge_length(h.edge()), h.edge()))
+        })
+        .collect();
+    edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+    edges.into_iter().map(|(_, e)| e).collect()
 }
 
 /// The fold between two faces of `faces` (a run of one strip) nearest its middle.
@@ -600,26 +688,66 @@ impl Welded {
         })
     }
 
-    /// The pieces' names: `S<strip>.<piece>` along each strip, `S<strip>` for a strip
-    /// in one piece (`members` in the order of their lowest face: along the strips).
-    fn names(&self, members: &[Vec<u32>]) -> Vec<Name> {
-        let strip = |faces: &Vec<u32>| self.strip_of_face[faces[0] as usize];
-        let mut pieces = vec![0u32; self.strips as usize];
-        for faces in members {
-            pieces[strip(faces) as usize] += 1;
+    /// The strip most of `faces` lie on (the lower on a tie): a piece with no room
+    /// for its id that was joined to a neighbour goes by the neighbour's strip.
+    fn strip_of(&self, faces: &[u32]) -> u32 {
+        let mut counts: BTreeMap<u32, usize> = BTreeMap::new();
+        for &f in faces {
+            *counts.entry(self.strip_of_face[f as usize]).or_default() += 1;
         }
+        let most = counts.values().copied().max().unwrap_or(0);
+        counts
+            .into_iter()
+            .find_map(|(strip, n)| (n == most).then_some(strip))
+            .unwrap_or(0)
+    }
+
+    /// The pieces' names: `S<strip>.<piece>` along each strip (in the order of each
+    /// piece's lowest face on it), `S<strip>` for a strip in one piece.
+    fn names(&self, members: &[Vec<u32>]) -> Vec<Name> {
+        let strips: Vec<u32> = members.iter().map(|faces| self.strip_of(faces)).collect();
+        let first_on = |k: usize| {
+            members[k]
+                .iter()
+                .copied()
+                .find(|&f| self.strip_of_face[f as usize] == strips[k])
+        };
+        let mut order: Vec<usize> = (0..members.len()).collect();
+        order.sort_by_key(|&k| (strips[k], first_on(k)));
+        let mut pieces = vec![0u32; self.strips as usize];
+        for &s in &strips {
+            pieces[s as usize] += 1;
+        }
+        let mut names = vec![Name::new(&STRIP, 0); members.len()];
         let mut seen = vec![0u32; self.strips as usize];
-        members
-            .iter()
-            .map(|faces| {
-                let s = strip(faces) as usize;
-                seen[s] += 1;
-                match pieces[s] {
-                    1 => Name::new(&STRIP, s as u32 + 1),
-                    _ => Name::with_part(&STRIP, s as u32 + 1, seen[s]),
+        for k in order {
+            let s = strips[k] as usize;
+            seen[s] += 1;
+            names[k] = match pieces[s] {
+                1 => Name::new(&STRIP, s as u32 + 1),
+                _ => Name::with_part(&STRIP, s as u32 + 1, seen[s]),
+            };
+        }
+        names
+    }
+
+    /// The faces of each piece that lie on another strip than the one it is named
+    /// after (pieces with no room for their id, joined to it), as (piece, strip from
+    /// 1, faces).
+    fn joined(&self, members: &[Vec<u32>]) -> Vec<(usize, u32, Vec<u32>)> {
+        let mut joined = Vec::new();
+        for (k, faces) in members.iter().enumerate() {
+            let own = self.strip_of(faces);
+            let mut others: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
+            for &f in faces {
+                let strip = self.strip_of_face[f as usize];
+                if strip != own {
+                    others.entry(strip).or_default().push(f);
                 }
-            })
-            .collect()
+            }
+            joined.extend(others.into_iter().map(|(s, faces)| (k, s + 1, faces)));
+        }
+        joined
     }
 }
 
@@ -3330,5 +3458,40 @@ mod tests {
         let folded = strip(vec![at(1.0, 0.0), at(1.0, 1.0), at(0.5, 0.2)]);
         assert!(joined(&[below.clone(), beside]));
         assert!(!joined(&[below, folded]));
+    }
+
+    #[test]
+    fn a_piece_goes_by_the_strip_most_of_it_lies_on() {
+        // Two strips of six triangles each, side by side along y = 1: the band
+        // 0 ≤ y ≤ 1 and the band 1 ≤ y ≤ 2, both zigzagging along x.
+        let band = |y: f64| {
+            let points = (0..4)
+                .flat_map(|i| {
+                    [
+                        DVec3::new(i as f64, y, 0.0),
+                        DVec3::new(i as f64, y + 1.0, 0.0),
+                    ]
+                })
+                .collect::<Vec<_>>();
+            let triangles = (0..6u32)
+                .map(|i| match i % 2 {
+                    0 => [i, i + 2, i + 1],
+                    _ => [i, i + 1, i + 2],
+                })
+                .collect();
+            Strip { points, triangles }
+        };
+        let welded = Welded::new(&[band(0.0), band(1.0)]).expect("welded");
+        assert_eq!(welded.strip_of_face, [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]);
+        // A face of the first strip joined to a run of the second, after another run
+        // of the second that comes first along it.
+        let members = vec![vec![0, 8, 9, 10, 11], vec![1, 2, 3, 4, 5], vec![6, 7]];
+        let names: Vec<String> = welded
+            .names(&members)
+            .iter()
+            .map(|n| n.to_string())
+            .collect();
+        assert_eq!(names, ["S2.2", "S1", "S2.1"]);
+        assert_eq!(welded.joined(&members), [(0, 1, vec![0])]);
     }
 }
