@@ -434,6 +434,15 @@ fn within_unsimplified(
         |a: Soup, b: Soup| both_ways(a, b, &|from, to| one_way_distance(from, to, spacing / 4.0));
     let to_model =
         |covered: &Covering| beyond(&strip_soup(&covered.banded.strips), unsimplified, bound);
+    // A narrower try that finds no strips says why it was narrower.
+    let narrowed = |tolerance: f64| {
+        cover(tolerance).map_err(|e| match e {
+            SchemeError::Model(why) => SchemeError::Model(format!(
+                "{why}, or less simplification (more --target-edges or --target-faces, or none): the strips were kept within {tolerance:.3} mm of the simplified model, not {bound:.3} mm, because it strays from the model as given"
+            )),
+            other => other,
+        })
+    };
     let first = cover(bound)?;
     let measured = to_model(&first);
     if measured <= bound {
@@ -447,7 +456,7 @@ fn within_unsimplified(
     drop(first);
     let narrower = bound - NARROWER_MARGIN * (strayed - bound);
     let second = if narrower >= LEAST_SHARE * bound {
-        let second = cover(narrower)?;
+        let second = narrowed(narrower)?;
         let measured = to_model(&second);
         if measured <= bound {
             return Ok((second, measured));
@@ -482,7 +491,7 @@ fn within_unsimplified(
             simplification / (1.0 - LEAST_SHARE)
         )));
     }
-    let last = cover(assured)?;
+    let last = narrowed(assured)?;
     let measured = to_model(&last);
     Ok(kept(last, measured))
 }
