@@ -419,9 +419,11 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
     let least_fold = job.scheme.least_scored_fold();
     let (flat, labels_left_out) = unroll_all(&output.panels, LabelOptions::default(), least_fold)
         .map_err(|e| Error::internal("unrolling the panels", e))?;
-    let warning = crate::sanity::check_labels(job, mesh, flat.len(), &labels_left_out, &|| {
-        prepared.clean_budget(job)
-    })?;
+    let unsimplified = prepared.unsimplified.as_deref();
+    let budget = || prepared.clean_budget(job);
+    let left_out = &labels_left_out;
+    let warning =
+        crate::sanity::check_labels(job, mesh, unsimplified, flat.len(), left_out, &budget)?;
     if let Some(bad) = flat.iter().find(|p| !is_simple(&p.outer())) {
         // Say why when a face far from planar was kept by a loose tolerance: its panel
         // is a projection of a warped polygon.
@@ -845,8 +847,9 @@ fn build(job: &Job, warn: &mut dyn FnMut(&str)) -> Result<Outcome> {
     progress.stage("making the panels");
     let output = scheme(job, &prepared)?;
     crate::internal::name_panels(output.panels.iter().map(|p| p.id().to_string()));
-    let fastening =
-        crate::sanity::check_fasteners(job, &prepared.scheme_mesh.mesh, &output, &budget)?;
+    let mesh = &prepared.scheme_mesh.mesh;
+    let unsimplified = prepared.unsimplified.as_deref();
+    let fastening = crate::sanity::check_fasteners(job, mesh, unsimplified, &output, &budget)?;
     // Under --strict it is a refusal after the label check (which may refuse first).
     if let (Some(warning), false) = (&fastening, job.strict) {
         warn(warning);

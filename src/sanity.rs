@@ -9,6 +9,8 @@
 
 use std::path::Path;
 
+use glam::DVec3;
+
 use crate::config::{Job, LengthUnit};
 use crate::error::{Error, Result};
 use crate::labels::LabelOptions;
@@ -150,6 +152,7 @@ fn strict(job: &Job, warnings: &[String]) -> Result<()> {
 pub fn check_labels(
     job: &Job,
     mesh: &Mesh,
+    unsimplified: Option<&[[DVec3; 3]]>,
     panels: usize,
     left_out: &crate::labels::LeftOut,
     budget: &dyn Fn() -> Option<Suggestion>,
@@ -164,7 +167,8 @@ pub fn check_labels(
         left_out.partner
     );
     if !job.scheme.panels_follow_faces() {
-        return panels_too_small(job, mesh, &what, &|output| ids_mostly_fit(job, output)).map(Some);
+        let fits = |output: &SchemeOutput| ids_mostly_fit(job, output);
+        return panels_too_small(job, mesh, unsimplified, &what, &fits).map(Some);
     }
     let most = 2 * left_out.panel > panels;
     too_detailed(job, mesh, &what, most, budget).map(Some)
@@ -177,10 +181,11 @@ pub fn check_labels(
 fn panels_too_small(
     job: &Job,
     mesh: &Mesh,
+    unsimplified: Option<&[[DVec3; 3]]>,
     what: &str,
     fits: &dyn Fn(&SchemeOutput) -> bool,
 ) -> Result<String> {
-    let fix = match job.scheme.larger_panels(mesh, fits) {
+    let fix = match job.scheme.larger_panels(mesh, unsimplified, fits) {
         Some(options) => format!("{options} gives them room"),
         None => format!("try {}", job.scheme.larger_panels_fix()),
     };
@@ -760,6 +765,7 @@ const AREA_PER_EDGE: f64 = 0.288_675;
 pub fn check_fasteners(
     job: &Job,
     mesh: &Mesh,
+    unsimplified: Option<&[[DVec3; 3]]>,
     output: &SchemeOutput,
     budget: &dyn Fn() -> Option<Suggestion>,
 ) -> Result<Option<String>> {
@@ -780,7 +786,7 @@ pub fn check_fasteners(
         );
         if !job.scheme.panels_follow_faces() {
             let fits = |output: &SchemeOutput| output.unfastened.is_empty();
-            return panels_too_small(job, mesh, &what, &fits).map(Some);
+            return panels_too_small(job, mesh, unsimplified, &what, &fits).map(Some);
         }
         return too_detailed(job, mesh, &what, 2 * n > connections, budget).map(Some);
     }

@@ -101,9 +101,15 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
     }
     /// For a scheme whose panels do not follow the faces: its options that make the
     /// panels of `mesh` large enough for what `fits` asks (their ids, their
-    /// fasteners), found by building them, as the command line writes them
+    /// fasteners), found by building them as the job does (near `unsimplified`, the
+    /// model before simplifying, where it was kept), as the command line writes them
     /// ("--max-deviation 2%"); `None` where none it tries does.
-    fn larger_panels(&self, _mesh: &Mesh, _fits: &dyn Fn(&SchemeOutput) -> bool) -> Option<String> {
+    fn larger_panels(
+        &self,
+        _mesh: &Mesh,
+        _unsimplified: Option<&[[DVec3; 3]]>,
+        _fits: &dyn Fn(&SchemeOutput) -> bool,
+    ) -> Option<String> {
         None
     }
     /// True when the scheme keeps its panels within a distance of the model (the strip
@@ -430,9 +436,10 @@ impl ConfiguredScheme {
     pub fn larger_panels(
         &self,
         mesh: &Mesh,
+        unsimplified: Option<&[[DVec3; 3]]>,
         fits: &dyn Fn(&SchemeOutput) -> bool,
     ) -> Option<String> {
-        self.options.larger_panels(mesh, fits)
+        self.options.larger_panels(mesh, unsimplified, fits)
     }
 
     /// The manifest's `scheme.params`: the shared options, then the scheme's own.

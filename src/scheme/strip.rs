@@ -246,7 +246,12 @@ impl Configured for StripOptions {
         "a larger --max-deviation (wider strips) or a larger --size"
     }
 
-    fn larger_panels(&self, mesh: &Mesh, fits: &dyn Fn(&SchemeOutput) -> bool) -> Option<String> {
+    fn larger_panels(
+        &self,
+        mesh: &Mesh,
+        unsimplified: Option<&[[DVec3; 3]]>,
+        fits: &dyn Fn(&SchemeOutput) -> bool,
+    ) -> Option<String> {
         // Strips widen about as the root of the bound: doubling it three times makes
         // them nearly three times wider.
         [2.0, 4.0, 8.0].into_iter().find_map(|k| {
@@ -254,7 +259,7 @@ impl Configured for StripOptions {
                 max_deviation: self.max_deviation.times(k),
                 ..self.clone()
             };
-            let output = strip_panels(mesh, &wider, None).ok()?;
+            let output = strip_panels(mesh, &wider, unsimplified).ok()?;
             fits(&output).then(|| format!("--max-deviation {}", wider.max_deviation))
         })
     }
