@@ -589,7 +589,8 @@ fn next_joins(
             }
             Some(_) => {}
             None => {
-                let edges = joining_edges(mesh, faces, &|f| !roomless[piece_of[f as usize]]);
+                let piece = |f: u32| piece_of[f as usize];
+                let edges = joining_edges(mesh, faces, &piece, &|k| !roomless[k]);
                 changed |= !edges.is_empty();
                 joins.insert(faces[0], (edges, 0));
             }
@@ -598,18 +599,31 @@ fn next_joins(
     changed
 }
 
-/// The edges between `faces` and faces of other pieces that have room for their id
-/// (`roomy`), longest first.
-fn joining_edges(mesh: &Mesh, faces: &[u32], roomy: &dyn Fn(u32) -> bool) -> Vec<EdgeId> {
-    let mut edges: Vec<(f64, EdgeId)> = faces
-        .iter()
-        .flat_map(|&f| mesh.face_half_edges(FaceId(f)))
-        .filter_map(|h| {
-            let across = mesh.face(h.twin())?;
-            (!faces.contains(&across.0) && roomy(across.0))
-                .then(|| (mesh.edge_length(h.edge()), h.edge()))
-        })
-        .collect();
+/// The longest edge between `faces` and each other piece that has room for its id
+/// (`piece_of` a face, `roomy`), longest first: a join refused along one edge is
+/// seldom made along a shorter one to the same piece.
+fn joining_edges(
+    mesh: &Mesh,
+    faces: &[u32],
+    piece_of: &dyn Fn(u32) -> usize,
+    roomy: &dyn Fn(usize) -> bool,
+) -> Vec<EdgeId> {
+    let mut longest: BTreeMap<usize, (f64, EdgeId)> = BTreeMap::new();
+    for h in faces.iter().flat_map(|&f| mesh.face_half_edges(FaceId(f))) {
+        let Some(across) = mesh.face(h.twin()) else {
+            continue;
+        };
+        let piece = piece_of(across.0);
+        if faces.contains(&across.0) || !roomy(piece) {
+            continue;
+        }
+        let edge = (mesh.edge_length(h.edge()), h.edge());
+        let best = longest.entry(piece).or_insert(edge);
+        if edge.0 > best.0 || (edge.0 == best.0 && edge.1 < best.1) {
+            *best = edge;
+        }
+    }
+    let mut edges: Vec<(f64, EdgeId)> = longest.into_values().collect();
     edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     edges.into_iter().map(|(_, e)| e).collect()
 }
