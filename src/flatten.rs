@@ -261,8 +261,10 @@ pub fn unroll_and_fit<'a>(
     unroll_fit(panel.into(), options, LEAST_SCORED_FOLD)
 }
 
-/// [`unroll_and_fit`], scoring only hinges that fold by more than `least_fold`.
-fn unroll_fit(
+/// [`unroll_and_fit`], scoring only hinges that fold by more than `least_fold`
+/// (radians): the labels fit as the flatten stage fits them for a scheme that scores
+/// only those.
+pub fn unroll_fit(
     panel: PanelRef,
     options: LabelOptions,
     least_fold: f64,

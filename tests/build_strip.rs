@@ -177,11 +177,24 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
         let id = panel.id();
         assert_eq!(id.to_string().chars().next(), Some('S'), "{what}: {id}");
         assert_no_interior_vertex(what, &format!("piece {id}"), surface, &group.faces);
+        // A piece is a run of its strip, and of each strip joined to it.
+        let mut runs: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
         for &f in &group.faces {
             assert!(covered.insert(f), "{what}: face {f} in two pieces");
             let strip = joined.get(&f).copied().unwrap_or(id.number);
             strips.entry(strip).or_default().push(f);
+            runs.entry(strip).or_default().push(f);
         }
+        for (strip, faces) in &runs {
+            assert!(
+                faces.windows(2).all(|w| w[1] == w[0] + 1),
+                "{what}: {id}'s faces of S{strip} are not one run"
+            );
+        }
+        assert!(
+            runs.contains_key(&id.number),
+            "{what}: {id} has no face of its strip"
+        );
     }
     assert_eq!(
         covered.len(),

@@ -442,9 +442,12 @@ fn within_unsimplified(
     // A narrower try that finds no strips says why it was narrower.
     let narrowed = |tolerance: f64| {
         cover(tolerance).map_err(|e| match e {
-            SchemeError::Model(why) => SchemeError::Model(format!(
-                "{why}, or less simplification (more --target-edges or --target-faces, or none): the strips were kept within {tolerance:.3} mm of the simplified model, not {bound:.3} mm, because it strays from the model as given"
-            )),
+            SchemeError::Model(why) => {
+                let why = why.replacen("of the model:", "of the simplified model:", 1);
+                SchemeError::Model(format!(
+                    "{why}, or less simplification (more --target-edges or --target-faces, or none): the strips were kept within {tolerance:.3} mm of the simplified model, not {bound:.3} mm, because it strays from the model as given"
+                ))
+            }
             other => other,
         })
     };
@@ -544,7 +547,13 @@ fn clear_pieces(
             folds.retain(|&e| e != rung);
             continue;
         }
-        if !next_joins(&welded.mesh, &net.output, &faces_of, &mut joins) {
+        if !next_joins(
+            &welded.mesh,
+            &net.output,
+            &faces_of,
+            options.flat_fold,
+            &mut joins,
+        ) {
             let faces_of = faces_of.clone();
             return (net, faces_of);
         }
@@ -552,19 +561,23 @@ fn clear_pieces(
 }
 
 /// Updates the joins of pieces with no room for their id (`joins`, see
-/// [`clear_pieces`]) after a net was grown with them: a piece still without room
-/// tries its next edge, a new one its first. False when nothing changed.
+/// [`clear_pieces`]) after a net was grown with them (its ids fitted as the flatten
+/// stage fits them, scoring folds over `least_fold`): a piece still without room
+/// tries its next edge, a new one its first, and one whose last edge left it without
+/// room drops that join, which only took its neighbour's room. False when nothing
+/// changed.
 fn next_joins(
     mesh: &Mesh,
     output: &SchemeOutput,
     faces_of: &[Vec<u32>],
+    least_fold: f64,
     joins: &mut BTreeMap<u32, (Vec<EdgeId>, usize)>,
 ) -> bool {
     let labels = crate::labels::LabelOptions::default();
     let roomless: Vec<bool> = (0..output.panels.len())
         .into_par_iter()
         .map(|k| {
-            crate::flatten::unroll_and_fit(output.panels.get(k), labels)
+            crate::flatten::unroll_fit(output.panels.get(k), labels, least_fold)
                 .is_ok_and(|(_, left)| left.panel > 0)
         })
         .collect();
@@ -583,7 +596,8 @@ fn next_joins(
             .iter_mut()
             .find(|(first, _)| piece_of[**first as usize] == k);
         match tried {
-            Some((_, (edges, next))) if *next + 1 < edges.len() => {
+            // Past the last edge, no edge is tried (`edges.get` finds none).
+            Some((_, (edges, next))) if *next < edges.len() => {
                 *next += 1;
                 changed = true;
             }
