@@ -443,6 +443,8 @@ fn within_unsimplified(
     let narrowed = |tolerance: f64| {
         cover(tolerance).map_err(|e| match e {
             SchemeError::Model(why) => {
+                // `covering` names the mesh it covered "the model"; here it is the
+                // simplified one.
                 let why = why.replacen("of the model:", "of the simplified model:", 1);
                 SchemeError::Model(format!(
                     "{why}, or less simplification (more --target-edges or --target-faces, or none): the strips were kept within {tolerance:.3} mm of the simplified model, not {bound:.3} mm, because it strays from the model as given"
@@ -554,8 +556,8 @@ fn clear_pieces(
             options.flat_fold,
             &mut joins,
         ) {
-            let faces_of = faces_of.clone();
-            return (net, faces_of);
+            drop(faces_of);
+            return (net, members.take());
         }
     }
 }
