@@ -499,7 +499,7 @@ fn strips_too_narrow_for_their_ids_warn_with_a_bound_that_gives_them_room() {
     let tmp = TempDir::new().unwrap();
     let model = torus(tmp.path(), 48, 24, 80.0, 30.0);
     let out = tmp.path().join("out");
-    let args = ["--scheme", "strip", "--size", "8in", "--quiet"];
+    let args = ["--scheme", "strip", "--size", "9in", "--quiet"];
     // Warned (built), and refused under --strict with nothing written.
     let run = unfold_command()
         .arg(&model)

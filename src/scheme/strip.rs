@@ -286,6 +286,12 @@ fn strip_panels(
         .panel
         .panel_limit
         .map_or(f64::INFINITY, |limit| limit.width.min(limit.height));
+    // A strip longer than the sheet's longer side is cut into equal pieces no longer.
+    let piece_length = options
+        .net
+        .panel
+        .panel_limit
+        .map_or(f64::INFINITY, |limit| limit.width.max(limit.height));
     let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length);
     let (covered, measured) = match unsimplified {
         None => {
@@ -306,7 +312,7 @@ fn strip_panels(
         let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
         strip(h) <= strip(h.twin())
     };
-    let (net, members) = clear_pieces(&welded, &options.net, &tab_first);
+    let (net, members) = clear_pieces(&welded, &options.net, piece_length, &tab_first);
     let joined = welded.joined(&members);
     let mut output = net.output;
     let pieces = output.panels.len();
@@ -506,7 +512,8 @@ fn within_unsimplified(
     Ok(kept(last, measured))
 }
 
-/// The pieces: islands grown along the strips' rungs, in order. A piece whose outline,
+/// The pieces: islands grown along the strips' rungs, in order, each strip longer than
+/// `piece_length` first cut at rungs into equal pieces no longer. A piece whose outline,
 /// tabs included, meets itself when unrolled (its faces wrap round a corner of its
 /// strip's side until two of their edges lie on one line) is cut at its middle rung
 /// and the pieces are grown again. A piece with no room for its id (a sliver where a
@@ -517,6 +524,7 @@ fn within_unsimplified(
 fn clear_pieces(
     welded: &Welded,
     options: &NetOptions,
+    piece_length: f64,
     tab_first: &dyn Fn(HalfedgeId) -> bool,
 ) -> (IslandNet, Vec<Vec<u32>>) {
     // The faces of each piece, in the order of the panels, as the net names them.
@@ -525,7 +533,7 @@ fn clear_pieces(
         *members.borrow_mut() = faces.to_vec();
         welded.names(faces)
     };
-    let mut folds = welded.folds.clone();
+    let mut folds = welded.shorter_than(piece_length);
     // Each piece without room for its id, by its lowest face: the edges it may join a
     // neighbour along, longest first, and which of them is tried.
     let mut joins: BTreeMap<u32, (Vec<EdgeId>, usize)> = BTreeMap::new();
@@ -730,6 +738,55 @@ impl Welded {
             folds,
             strips: count,
         })
+    }
+
+    /// The folds of the strips, less the rungs that cut each strip longer than
+    /// `length` (along its faces' centres) into equal pieces no longer: a long ring
+    /// unrolls into an arc that nests as badly as it is long.
+    fn shorter_than(&self, length: f64) -> Vec<EdgeId> {
+        if !length.is_finite() {
+            return self.folds.clone();
+        }
+        // The middle of the rung between faces f - 1 and f (or of face f's corners).
+        let centre = |f: usize| {
+            let rung = (f > 0)
+                .then(|| shared_edge(&self.mesh, FaceId(f as u32 - 1), FaceId(f as u32)))
+                .flatten();
+            match rung {
+                Some(e) => {
+                    let (a, b) = self.mesh.edge_vertices(e);
+                    0.5 * (self.mesh.position(a) + self.mesh.position(b))
+                }
+                None => self.mesh.face_positions(FaceId(f as u32)).sum::<DVec3>() / 3.0,
+            }
+        };
+        let mut cuts = std::collections::BTreeSet::new();
+        let mut start = 0;
+        while start < self.strip_of_face.len() {
+            let strip = self.strip_of_face[start];
+            let end = (start..self.strip_of_face.len())
+                .find(|&f| self.strip_of_face[f] != strip)
+                .unwrap_or(self.strip_of_face.len());
+            let mut along = vec![0.0];
+            for f in start + 1..end {
+                along.push(along[along.len() - 1] + centre(f - 1).distance(centre(f)));
+            }
+            let total = along[along.len() - 1];
+            let pieces = (total / length).ceil() as usize;
+            for k in 1..pieces {
+                let target = total * k as f64 / pieces as f64;
+                let f = start + along.partition_point(|&a| a < target).max(1);
+                if let Some(e) = shared_edge(&self.mesh, FaceId(f as u32 - 1), FaceId(f as u32)) {
+                    cuts.insert(e);
+                }
+            }
+            start = end;
+        }
+        self.folds
+            .iter()
+            .copied()
+            .filter(|e| !cuts.contains(e))
+            .collect()
     }
 
     /// The strip most of `faces` lie on (the lower on a tie): a piece with no room
@@ -1873,7 +1930,8 @@ const MOST_SPLITS: usize = 40;
 /// the points between). From one band over each part of the surface, a band whose
 /// strip strays is cut across into sectors about `sector_length` long if it is longer
 /// (a ring round a body strays where the body is sharpest, and the rest of it need not
-/// be split with it), else split into equal bands, as many as should bring it within;
+/// be split with it), grown in bands from its lower curve up where it is a sector or a
+/// cap round a pole, else split into equal bands, as many as should bring it within;
 /// each sector and band on its own, until none strays.
 pub fn strips_within(
     surface: &Triangles,
@@ -1985,6 +2043,12 @@ impl Cover {
             Err(why) if narrow => return Err(why),
             Err(_) => f64::INFINITY,
         };
+        // The first band grown's width, guessed from how far the patch's one strip
+        // strayed: a strip's distance grows about as its width squared.
+        let guess = match deviation.is_finite() {
+            true => (hi - lo) * (self.within / deviation).sqrt(),
+            false => 0.25 * (hi - lo),
+        };
         match self.sectors(patch) {
             Sectors::Cut(sectors) => {
                 let deeper = depth.deeper();
@@ -2002,10 +2066,6 @@ impl Cover {
                 return longer.strips(patch, depth);
             }
             Sectors::Short => {
-                let guess = match deviation.is_finite() {
-                    true => (hi - lo) * (self.within / deviation).sqrt(),
-                    false => 0.25 * (hi - lo),
-                };
                 if let Some(covered) = self.grown(patch, guess) {
                     return Ok(covered);
                 }
@@ -2019,6 +2079,13 @@ impl Cover {
                         ..depth
                     },
                 );
+            }
+            // A cap grows from its pole (or up to it) in rings: split into equal
+            // bands, its innermost band would be no wider than a cap can be.
+            Sectors::Cap => {
+                if let Some(covered) = self.grown(patch, guess) {
+                    return Ok(covered);
+                }
             }
             Sectors::Unfit => {}
         }
@@ -2122,6 +2189,10 @@ impl Cover {
             .iter()
             .flat_map(|l| runs(l, |i| value(i) == hi))
             .count();
+        match (loops.len(), lower.as_slice(), upper) {
+            (1, [], 1) | (1, [(_, true)], 0) => return Sectors::Cap,
+            _ => {}
+        }
         let [(run, closed)] = lower.as_slice() else {
             return Sectors::Unfit;
         };
@@ -2246,6 +2317,8 @@ enum Sectors {
     Cut(Vec<Patch>),
     /// None: the patch is no longer than a sector.
     Short,
+    /// None: the patch is a cap, one loop round a pole.
+    Cap,
     /// None: the patch is not a band between one run of each curve, or has no way across.
     Unfit,
 }
@@ -3537,5 +3610,48 @@ mod tests {
             .collect();
         assert_eq!(names, ["S2.2", "S1", "S2.1"]);
         assert_eq!(welded.joined(&members), [(0, 1, vec![0])]);
+    }
+
+    #[test]
+    fn a_long_strip_is_cut_into_equal_pieces_no_longer_than_asked() {
+        // A band 1 wide and 100 long, a rung at every unit: 200 triangles, 199 folds.
+        let points = (0..=100)
+            .flat_map(|i| {
+                [
+                    DVec3::new(i as f64, 0.0, 0.0),
+                    DVec3::new(i as f64, 1.0, 0.0),
+                ]
+            })
+            .collect::<Vec<_>>();
+        let triangles = (0..200u32)
+            .map(|i| match i % 2 {
+                0 => [i, i + 2, i + 1],
+                _ => [i, i + 1, i + 2],
+            })
+            .collect();
+        let welded = Welded::new(&[Strip { points, triangles }]).expect("welded");
+        assert_eq!(welded.folds.len(), 199);
+        assert_eq!(welded.shorter_than(f64::INFINITY), welded.folds);
+        assert_eq!(welded.shorter_than(100.0), welded.folds);
+        // 100 long in pieces of at most 30: four, cut near 25, 50 and 75.
+        let folds = welded.shorter_than(30.0);
+        let cut: Vec<EdgeId> = welded
+            .folds
+            .iter()
+            .copied()
+            .filter(|e| !folds.contains(e))
+            .collect();
+        assert_eq!(cut.len(), 3);
+        let mut at: Vec<f64> = cut
+            .iter()
+            .map(|&e| {
+                let (a, b) = welded.mesh.edge_vertices(e);
+                0.5 * (welded.mesh.position(a).x + welded.mesh.position(b).x)
+            })
+            .collect();
+        at.sort_by(f64::total_cmp);
+        for (x, target) in at.iter().zip([25.0, 50.0, 75.0]) {
+            assert!((x - target).abs() <= 1.0, "cut at {x}, not near {target}");
+        }
     }
 }
