@@ -3577,27 +3577,31 @@ mod tests {
         assert!(!joined(&[below, folded]));
     }
 
+    /// The band from height `y` to `y + 1`, from x = 0 to `length`, zigzagging along x with a rung
+    /// at every unit: two triangles per unit.
+    fn zigzag(length: u32, y: f64) -> Strip {
+        let points = (0..=length)
+            .flat_map(|i| {
+                [
+                    DVec3::new(i as f64, y, 0.0),
+                    DVec3::new(i as f64, y + 1.0, 0.0),
+                ]
+            })
+            .collect::<Vec<_>>();
+        let triangles = (0..2 * length)
+            .map(|i| match i % 2 {
+                0 => [i, i + 2, i + 1],
+                _ => [i, i + 1, i + 2],
+            })
+            .collect();
+        Strip { points, triangles }
+    }
+
     #[test]
     fn a_piece_goes_by_the_strip_most_of_it_lies_on() {
         // Two strips of six triangles each, side by side along y = 1: the band
         // 0 ≤ y ≤ 1 and the band 1 ≤ y ≤ 2, both zigzagging along x.
-        let band = |y: f64| {
-            let points = (0..4)
-                .flat_map(|i| {
-                    [
-                        DVec3::new(i as f64, y, 0.0),
-                        DVec3::new(i as f64, y + 1.0, 0.0),
-                    ]
-                })
-                .collect::<Vec<_>>();
-            let triangles = (0..6u32)
-                .map(|i| match i % 2 {
-                    0 => [i, i + 2, i + 1],
-                    _ => [i, i + 1, i + 2],
-                })
-                .collect();
-            Strip { points, triangles }
-        };
+        let band = |y: f64| zigzag(3, y);
         let welded = Welded::new(&[band(0.0), band(1.0)]).expect("welded");
         assert_eq!(welded.strip_of_face, [0, 0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 1]);
         // A face of the first strip joined to a run of the second, after another run
@@ -3615,21 +3619,7 @@ mod tests {
     #[test]
     fn a_long_strip_is_cut_into_equal_pieces_no_longer_than_asked() {
         // A band 1 wide and 100 long, a rung at every unit: 200 triangles, 199 folds.
-        let points = (0..=100)
-            .flat_map(|i| {
-                [
-                    DVec3::new(i as f64, 0.0, 0.0),
-                    DVec3::new(i as f64, 1.0, 0.0),
-                ]
-            })
-            .collect::<Vec<_>>();
-        let triangles = (0..200u32)
-            .map(|i| match i % 2 {
-                0 => [i, i + 2, i + 1],
-                _ => [i, i + 1, i + 2],
-            })
-            .collect();
-        let welded = Welded::new(&[Strip { points, triangles }]).expect("welded");
+        let welded = Welded::new(&[zigzag(100, 0.0)]).expect("welded");
         assert_eq!(welded.folds.len(), 199);
         assert_eq!(welded.shorter_than(f64::INFINITY), welded.folds);
         assert_eq!(welded.shorter_than(100.0), welded.folds);
