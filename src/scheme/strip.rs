@@ -1931,8 +1931,8 @@ const MOST_SPLITS: usize = 40;
 /// strip strays is cut across into sectors about `sector_length` long if it is longer
 /// (a ring round a body strays where the body is sharpest, and the rest of it need not
 /// be split with it), grown in bands from its lower curve up where it is a sector or a
-/// cap round a pole, else split into equal bands, as many as should bring it within;
-/// each sector and band on its own, until none strays.
+/// cap round a pole, else split in halves (quarters where it is closed); each sector
+/// and band on its own, until none strays.
 pub fn strips_within(
     surface: &Triangles,
     field: &[f64],
@@ -2070,7 +2070,7 @@ impl Cover {
                     return Ok(covered);
                 }
                 // Every strip of some band folds over its outline (round a saddle):
-                // split it in equal bands, taking such strips.
+                // split it in two, taking such strips.
                 return self.split(
                     patch,
                     deviation,
@@ -2080,8 +2080,8 @@ impl Cover {
                     },
                 );
             }
-            // A cap grows from its pole (or up to it) in rings: split into equal
-            // bands, its innermost band would be no wider than a cap can be.
+            // A cap grows from its pole (or up to it) in rings: split in halves, its
+            // innermost band would be no wider than a cap can be.
             Sectors::Cap => {
                 if let Some(covered) = self.grown(patch, guess) {
                     return Ok(covered);
@@ -2092,13 +2092,15 @@ impl Cover {
         self.split(patch, deviation, depth)
     }
 
-    /// The strips of `patch` split into equal bands, as many as should bring a strip
-    /// `deviation` from it within: its distance grows about as its width squared.
+    /// The strips of `patch` split in equal bands: in two where its one strip was
+    /// measured, four where it could not be (a closed part). Only halves: a strip
+    /// strays where the surface is sharpest, so more bands guessed from its distance
+    /// would be as narrow everywhere else, and bands once split are never joined.
     fn split(&self, patch: &Patch, deviation: f64, depth: Depth) -> Result<Vec<Covered>, String> {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
         let parts = match deviation.is_finite() {
-            true => ((deviation / self.within).sqrt().ceil() as usize).clamp(2, 8),
+            true => 2,
             false => 4,
         };
         let mut sorted = patch.values.clone();
