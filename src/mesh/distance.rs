@@ -206,6 +206,19 @@ impl<'a> TriangleGrid<'a> {
     /// without looking for the nearest. (A triangle at a hair more or less than `r`
     /// may be missed or taken: callers use it to skip work, not to decide.)
     pub fn reaches(&self, p: DVec3, r: f64) -> bool {
+        let mut no_hint = usize::MAX;
+        self.reaches_near(p, r, &mut no_hint)
+    }
+
+    /// [`TriangleGrid::reaches`], trying triangle `hint` first and leaving there the
+    /// triangle found: points asked one after the other along a surface mostly have
+    /// the same triangle within reach.
+    pub fn reaches_near(&self, p: DVec3, r: f64, hint: &mut usize) -> bool {
+        if let Some(&[a, b, c]) = self.triangles.get(*hint) {
+            if closest_point_on_triangle(p, a, b, c).distance(p) <= r {
+                return true;
+            }
+        }
         if self.triangles.is_empty() {
             return false;
         }
@@ -215,15 +228,18 @@ impl<'a> TriangleGrid<'a> {
             if ring > 0 && self.inside_distance(p, home, ring - 1) > r {
                 return false;
             }
-            let mut found = false;
+            let mut found = None;
             self.visit_ring(home, ring, |t| {
-                if found || box_distance(p, self.boxes[t]) > r {
+                if found.is_some() || box_distance(p, self.boxes[t]) > r {
                     return;
                 }
                 let [a, b, c] = self.triangles[t];
-                found = closest_point_on_triangle(p, a, b, c).distance(p) <= r;
+                if closest_point_on_triangle(p, a, b, c).distance(p) <= r {
+                    found = Some(t);
+                }
             });
-            if found {
+            if let Some(t) = found {
+                *hint = t;
                 return true;
             }
         }
@@ -322,6 +338,12 @@ mod tests {
             assert!((grid.distance(p) - brute).abs() < 1e-12, "{p}");
             assert!(grid.reaches(p, brute + 1e-9), "{p}");
             assert!(!grid.reaches(p, brute - 1e-9), "{p}");
+            // Whatever triangle it tries first, and leaves one within reach there.
+            let mut hint = (unit() * triangles.len() as f64) as usize;
+            assert!(!grid.reaches_near(p, brute - 1e-9, &mut hint), "{p}");
+            assert!(grid.reaches_near(p, brute + 1e-9, &mut hint), "{p}");
+            let [a, b, c] = triangles[hint];
+            assert!(closest_point_on_triangle(p, a, b, c).distance(p) <= brute + 1e-9);
         }
     }
 }

@@ -1372,9 +1372,10 @@ fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
 /// spread over `from`'s triangles no further than `spacing` apart.
 pub fn one_way_distance(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64) -> f64 {
     let grid = TriangleGrid::new(to);
+    let mut hint = usize::MAX;
     from.iter().fold(0.0, |worst, t| {
         let k = subdivisions(longest_side(t), spacing);
-        sampled_worst(&grid, t, k, worst)
+        sampled_worst(&grid, t, k, worst, &mut hint)
     })
 }
 
@@ -1396,6 +1397,8 @@ fn distance_beyond(
 ) -> f64 {
     let grid = TriangleGrid::new(to);
     let mut bound: f64 = 0.0;
+    // Neighbouring triangles of `from` mostly lie near the same triangle of `to`.
+    let mut hint = usize::MAX;
     for t in from {
         let longest = longest_side(t);
         let mut k = subdivisions(longest, spacing);
@@ -1403,7 +1406,7 @@ fn distance_beyond(
             // Every point of a triangle lies within its longest side over √3 of a
             // corner, and each sample triangle is this one shrunk k times.
             let reach = longest / k as f64 / 3f64.sqrt();
-            let worst = sampled_worst(&grid, t, k, (bound - reach).max(0.0));
+            let worst = sampled_worst(&grid, t, k, (bound - reach).max(0.0), &mut hint);
             let settled = worst + reach <= within || worst > within;
             if settled || k >= FINEST_SUBDIVISIONS {
                 bound = bound.max(worst + reach);
@@ -1436,8 +1439,16 @@ fn subdivisions(longest: f64, spacing: f64) -> usize {
 }
 
 /// The largest of `floor` and the distances to `grid`'s triangles from the points
-/// that divide `t`'s sides into `k`.
-fn sampled_worst(grid: &TriangleGrid, t: &[DVec3; 3], k: usize, floor: f64) -> f64 {
+/// that divide `t`'s sides into `k`. Each point tries triangle `hint` first, and
+/// leaves there the last found within the worst: neighbouring points mostly have the
+/// same one within reach.
+fn sampled_worst(
+    grid: &TriangleGrid,
+    t: &[DVec3; 3],
+    k: usize,
+    floor: f64,
+    hint: &mut usize,
+) -> f64 {
     let mut worst = floor;
     for i in 0..=k {
         for j in 0..=k - i {
@@ -1445,7 +1456,7 @@ fn sampled_worst(grid: &TriangleGrid, t: &[DVec3; 3], k: usize, floor: f64) -> f
             let point = t[0] + u * (t[1] - t[0]) + v * (t[2] - t[0]);
             // A point with a triangle no further than the worst so far cannot raise
             // it: only the others are measured to their nearest.
-            if !grid.reaches(point, worst) {
+            if !grid.reaches_near(point, worst, hint) {
                 worst = worst.max(grid.distance(point));
             }
         }
@@ -1463,7 +1474,7 @@ pub fn strip_soup(strips: &[Strip]) -> Vec<[DVec3; 3]> {
 
 /// Where a point of the sliced surface comes from: a corner of the surface, or where
 /// a level crosses one of its edges (the edge by its corners, lower first).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 enum Origin {
     Corner(u32),
     Crossing { edge: (u32, u32), level: u32 },
@@ -1522,7 +1533,8 @@ impl Slices {
             pieces: Vec::new(),
             held,
         };
-        let mut ids: BTreeMap<Origin, u32> = BTreeMap::new();
+        // Looked up only: points are numbered in the order they are first met.
+        let mut ids: HashMap<Origin, u32> = HashMap::new();
         for corners in &surface.corners {
             // The triangle as (origin, value, position) corners.
             let start: Vec<(Origin, f64, DVec3)> = corners
@@ -1597,9 +1609,24 @@ impl Slices {
     /// The regions: per band, its pieces joined across shared edges, in band order
     /// and then by their first piece.
     pub fn regions(&self) -> Vec<Region> {
+        self.regions_where(|_| true)
+    }
+
+    /// The regions of `band` alone (as [`Slices::regions`] gives them), without
+    /// building the others.
+    fn regions_of(&self, band: usize) -> Vec<Region> {
+        self.regions_where(|b| b == band)
+    }
+
+    /// The regions of the bands `wanted` takes, in band order and then by their first
+    /// piece.
+    fn regions_where(&self, wanted: impl Fn(usize) -> bool) -> Vec<Region> {
         let mut parent: Vec<u32> = (0..self.pieces.len() as u32).collect();
         let mut first_by_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
         for (k, (band, corners)) in self.pieces.iter().enumerate() {
+            if !wanted(*band) {
+                continue;
+            }
             for (a, b) in cycle_pairs(corners) {
                 match first_by_edge.entry((a.min(b), a.max(b))) {
                     std::collections::btree_map::Entry::Vacant(e) => {
@@ -1615,7 +1642,7 @@ impl Slices {
             }
         }
         let mut members: BTreeMap<(usize, u32), Vec<usize>> = BTreeMap::new();
-        for k in 0..self.pieces.len() {
+        for k in (0..self.pieces.len()).filter(|&k| wanted(self.pieces[k].0)) {
             let r = find(&mut parent, k as u32);
             members.entry((self.pieces[k].0, r)).or_default().push(k);
         }
@@ -2297,11 +2324,7 @@ impl Cover {
         levels.push(hi + margin);
         let band = usize::from(from > lo);
         let (slices, kept) = self.sliced(patch, levels);
-        let regions: Vec<Region> = slices
-            .regions()
-            .into_iter()
-            .filter(|r| r.band == band)
-            .collect();
+        let regions = slices.regions_of(band);
         let measured: Vec<Option<Covered>> = regions
             .par_iter()
             .map(|r| {
