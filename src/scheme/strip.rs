@@ -405,9 +405,13 @@ fn covering(
     })
 }
 
-/// How much further than the estimate of what the strips strayed the second try
+/// How much further than the estimate of what the strips strayed a narrower try
 /// narrows them: the narrower strips' worst point moves.
 const NARROWER_MARGIN: f64 = 1.5;
+
+/// How many narrower tries are made before the strips are kept within what the
+/// simplification leaves of the bound (which holds, but makes them much narrower).
+const MOST_NARROWER: usize = 3;
 
 /// The least share of the bound the strips may be kept within of a simplified mesh:
 /// narrower, they would be more than twice as many, and a simplification that leaves
@@ -464,23 +468,34 @@ fn within_unsimplified(
     if measured <= bound {
         return Ok((first, measured));
     }
-    // Where the finer samples find no point beyond the bound, the bound's own does.
-    let strayed = match sampled(&strip_soup(&first.banded.strips), unsimplified) {
+    // Narrower tries, each by what the one before strayed beyond the bound (where the
+    // finer samples find no point beyond it, the bound's own measure does): a band's
+    // worst point moves with its width, so one narrowing may not be enough.
+    let strayed = |covered: &Covering, measured: f64| match sampled(
+        &strip_soup(&covered.banded.strips),
+        unsimplified,
+    ) {
         finer if finer > bound => finer,
         _ => measured,
     };
+    let mut tolerance = bound;
+    let mut beyond_by = strayed(&first, measured) - bound;
     drop(first);
-    let narrower = bound - NARROWER_MARGIN * (strayed - bound);
-    let second = if narrower >= LEAST_SHARE * bound {
-        let second = narrowed(narrower)?;
-        let measured = to_model(&second);
-        if measured <= bound {
-            return Ok((second, measured));
+    let mut last_try = None;
+    for _ in 0..MOST_NARROWER {
+        let narrower = tolerance - NARROWER_MARGIN * beyond_by;
+        if narrower < LEAST_SHARE * bound {
+            break;
         }
-        Some((second, measured))
-    } else {
-        None
-    };
+        let covered = narrowed(narrower)?;
+        let measured = to_model(&covered);
+        if measured <= bound {
+            return Ok((covered, measured));
+        }
+        beyond_by = strayed(&covered, measured) - bound;
+        tolerance = narrower;
+        last_try = Some((covered, measured));
+    }
     // Refined against what the samples find, the bound comes close to it.
     let simplification = beyond(
         simplified,
@@ -495,9 +510,9 @@ fn within_unsimplified(
         let measured = measured.min(covered.banded.deviation + simplification);
         (covered, measured)
     };
-    match second {
-        Some((second, measured)) if second.banded.deviation <= assured => {
-            return Ok(kept(second, measured));
+    match last_try {
+        Some((covered, measured)) if covered.banded.deviation <= assured => {
+            return Ok(kept(covered, measured));
         }
         _ => {}
     }
