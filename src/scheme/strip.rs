@@ -279,19 +279,12 @@ fn strip_panels(
         &surface,
         &two_pole_field(&surface).map_err(SchemeError::Model)?,
     );
+    let limit = options.net.panel.panel_limit;
     // Bands are cut across into sectors about as long as the sheet's shorter side: an
     // unrolled sector is an arc, and shorter arcs nest closer (docs/benchmarks.md).
-    let sector_length = options
-        .net
-        .panel
-        .panel_limit
-        .map_or(f64::INFINITY, |limit| limit.width.min(limit.height));
+    let sector_length = limit.map_or(f64::INFINITY, |l| l.width.min(l.height));
     // A strip longer than the sheet's longer side is cut into equal pieces no longer.
-    let piece_length = options
-        .net
-        .panel
-        .panel_limit
-        .map_or(f64::INFINITY, |limit| limit.width.max(limit.height));
+    let piece_length = limit.map_or(f64::INFINITY, |l| l.width.max(l.height));
     let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length);
     let (covered, measured) = match unsimplified {
         None => {
@@ -1973,8 +1966,8 @@ const MOST_SPLITS: usize = 40;
 /// strip strays is cut across into sectors about `sector_length` long if it is longer
 /// (a ring round a body strays where the body is sharpest, and the rest of it need not
 /// be split with it), grown in bands from its lower curve up where it is a sector or a
-/// cap round a pole, else split in halves (quarters where it is closed); each sector
-/// and band on its own, until none strays.
+/// cap round a pole, else split in halves (quarters where no one strip could be built,
+/// as on a closed part); each sector and band on its own, until none strays.
 pub fn strips_within(
     surface: &Triangles,
     field: &[f64],
@@ -2122,8 +2115,8 @@ impl Cover {
                     },
                 );
             }
-            // A cap grows from its pole (or up to it) in rings: split in halves, its
-            // innermost band would be no wider than a cap can be.
+            // A cap grows from its pole (or up to it) in rings rather than being split:
+            // split, its innermost band would be no wider than a cap can be.
             Sectors::Cap => {
                 if let Some(covered) = self.grown(patch, guess) {
                     return Ok(covered);
@@ -2135,9 +2128,10 @@ impl Cover {
     }
 
     /// The strips of `patch` split in equal bands: in two where its one strip was
-    /// measured, four where it could not be (a closed part). Only halves: a strip
-    /// strays where the surface is sharpest, so more bands guessed from its distance
-    /// would be as narrow everywhere else, and bands once split are never joined.
+    /// measured, four where no one strip could be built (a closed part, or one whose
+    /// strip would fold over its outline). Only halves: a strip strays where the
+    /// surface is sharpest, so more bands guessed from its distance would be as narrow
+    /// everywhere else, and bands once split are never joined.
     fn split(&self, patch: &Patch, deviation: f64, depth: Depth) -> Result<Vec<Covered>, String> {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
