@@ -3701,6 +3701,68 @@ mod tests {
         assert_eq!(welded.joined(&members), [(0, 1, vec![0])]);
     }
 
+    /// A 25 mm square at height `z`, as two triangles.
+    fn square_at(z: f64) -> Vec<[DVec3; 3]> {
+        let p =
+            [(0.0, 0.0), (25.0, 0.0), (25.0, 25.0), (0.0, 25.0)].map(|(x, y)| DVec3::new(x, y, z));
+        vec![[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
+    }
+
+    /// Strips over a model as given (a square at height 0) built for a simplified
+    /// one (the square 4 mm up), each try's strips `strays(tolerance)` above that:
+    /// the tolerances the strips were asked to keep, the one they were kept within
+    /// and the distance measured to the model as given.
+    fn narrowed_tries(strays: impl Fn(f64) -> f64 + Sync) -> (Vec<f64>, f64, f64) {
+        let asked = std::sync::Mutex::new(Vec::new());
+        let cover = |tolerance: f64| {
+            asked.lock().unwrap().push(tolerance);
+            let deviation = strays(tolerance);
+            assert!(deviation <= tolerance, "{deviation} within {tolerance}");
+            let square = square_at(4.0 + deviation);
+            let strips = vec![Strip {
+                points: vec![square[0][0], square[0][1], square[0][2], square[1][2]],
+                triangles: vec![[0, 1, 2], [0, 2, 3]],
+            }];
+            Ok(Covering {
+                welded: Welded::new(&strips).unwrap(),
+                banded: Banded { strips, deviation },
+                whole_bands: false,
+                tolerance,
+            })
+        };
+        let (covered, measured) =
+            within_unsimplified(10.0, &square_at(4.0), &square_at(0.0), &cover).unwrap();
+        (asked.into_inner().unwrap(), covered.tolerance, measured)
+    }
+
+    #[test]
+    fn strips_that_stray_from_the_model_as_given_are_narrowed_up_to_three_times() {
+        // Each try narrower by 1.5 times what the one before strayed beyond 10 mm:
+        // 7 + 4 strays by 1, 6.5 + 4 by 0.5, 6.2 + 4 by 0.2, and 5.8 + 4 is within.
+        let table = |t: f64| match t {
+            t if t > 9.0 => 7.0,
+            t if t > 8.0 => 6.5,
+            t if t > 7.6 => 6.2,
+            _ => 5.8,
+        };
+        let (asked, kept, measured) = narrowed_tries(table);
+        let expected = [10.0, 8.5, 7.75, 7.45];
+        assert_eq!(asked.len(), expected.len(), "{asked:?}");
+        for (a, e) in asked.iter().zip(expected) {
+            assert!((a - e).abs() < 1e-9, "{asked:?}");
+        }
+        assert!(
+            (kept - 7.45).abs() < 1e-9 && measured <= 10.0,
+            "{kept} {measured}"
+        );
+        // Where the third narrower try strays too, the strips are kept within the
+        // bound less the simplification's 4 mm (and a little for its measure).
+        let (asked, kept, measured) = narrowed_tries(|t| table(t).max(6.5).min(t - 0.3));
+        assert_eq!(asked.len(), 5, "{asked:?}");
+        assert!(kept < 6.0 && kept > 5.7, "{asked:?}");
+        assert!(measured <= 10.0, "{measured}");
+    }
+
     #[test]
     fn a_long_strip_is_cut_into_equal_pieces_no_longer_than_asked() {
         // A band 1 wide and 100 long, a rung at every unit: 200 triangles, 199 folds.
