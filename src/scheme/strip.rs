@@ -2625,16 +2625,20 @@ fn weld_near(strips: &mut [Strip]) {
     }
 }
 
-/// `strip` with the ends of each of its edges that welding left without length made
-/// one point, and the triangles left without area dropped (a crossing welded onto the
-/// corner of its own edge). Its neighbours on either side of such a triangle share
-/// the rung it had, so the strip still runs triangle by triangle.
+/// `strip` with the ends of each of its outline edges that welding left without
+/// length made one point, and the triangles left without area dropped (a crossing
+/// welded onto the corner of its own edge). Its neighbours on either side of such a
+/// triangle share the rung it had, so the strip still runs triangle by triangle. A
+/// rung without length (where its two curves touch) stays: its two triangles are the
+/// strip's only link there.
 fn collapse_short_edges(strip: &mut Strip) {
     let mut parent: Vec<u32> = (0..strip.points.len() as u32).collect();
     let mut any = false;
+    let uses = edge_uses(&strip.triangles);
     for t in &strip.triangles {
         for (a, b) in cycle_pairs(t) {
-            if strip.points[a as usize] == strip.points[b as usize] {
+            let outline = uses[&(a.min(b), a.max(b))] == 1;
+            if outline && strip.points[a as usize] == strip.points[b as usize] {
                 union(&mut parent, a, b);
                 any = true;
             }
