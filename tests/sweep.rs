@@ -21,9 +21,9 @@ const SCHEMES: [&str; 6] = [
     "strip",
 ];
 /// Each kerf at least once, and mirroring both without a kerf and with the largest one
-/// (mirroring reverses the outlines the kerf offsets). Each model and scheme runs two of
-/// them, the other two on the next model: every scheme meets every case on half the
-/// models, in half the time.
+/// (mirroring reverses the outlines the kerf offsets). Each model and scheme runs one of
+/// them, the next on the next model: every scheme meets every case on a quarter of the
+/// models, in a quarter of the time.
 const KERF_MIRROR: [(&str, bool); 4] = [
     ("0mm", false),
     ("0.3mm", true),
@@ -80,10 +80,8 @@ fn every_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
     let mut cases = Vec::new();
     for (m, model) in models.iter().enumerate() {
         for (s, scheme) in SCHEMES.iter().enumerate() {
-            let half = 2 * ((m + s) % 2);
-            for &(kerf, mirror) in &KERF_MIRROR[half..half + 2] {
-                cases.push((model.clone(), scheme, kerf, mirror));
-            }
+            let (kerf, mirror) = KERF_MIRROR[(m + s) % KERF_MIRROR.len()];
+            cases.push((model.clone(), scheme, kerf, mirror));
         }
     }
     let next = AtomicUsize::new(0);

@@ -118,8 +118,9 @@ where
     finish(unfold_command().args(args))
 }
 
-/// Runs `unfold MODEL --scheme SCHEME --size SIZE --out OUT EXTRA… --build-anyway`, asserts success and
-/// returns the parsed `manifest.json` with the run (for its report on stderr).
+/// Runs `unfold MODEL --scheme SCHEME --size SIZE --out OUT EXTRA… --build-anyway` (with
+/// `--effort 1` unless EXTRA names an effort or a nester), asserts success and returns
+/// the parsed `manifest.json` with the run (for its report on stderr).
 pub fn build_run(
     scheme: &str,
     model: &Path,
@@ -140,6 +141,11 @@ pub fn build_run(
     // Models more detailed than their size are built on purpose (size_checks.rs tests
     // the stop).
     args.push(OsStr::new("--build-anyway"));
+    // The true-shape search at its quickest: these builds check the sheets, not how
+    // tight they are (the nesting tests and the benchmarks judge that at the default).
+    if !extra.iter().any(|a| *a == "--effort" || *a == "--nester") {
+        args.extend([OsStr::new("--effort"), OsStr::new("1")]);
+    }
     let run = unfold(&args);
     assert_eq!(run.code, Some(0), "unfold {args:?} failed:\n{}", run.stderr);
     (read_manifest(out), run)
