@@ -645,3 +645,57 @@ fn a_simplified_model_keeps_the_bound_to_the_model_as_given() {
     );
     assert!(!coarse.exists(), "nothing written");
 }
+
+/// A band whose strip folds over its outline however narrow it is split (round the
+/// sharp corners of a coarse model, or round holes) is not a matter of the bound: the
+/// refusal says a larger --max-deviation does not change it and names what builds,
+/// closing the holes where the model has any, and the net scheme.
+#[test]
+fn strips_that_fold_at_any_bound_name_what_builds() {
+    let Some(shared) = shared_models("strips_that_fold_at_any_bound_name_what_builds") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let out = tmp.path().join("out");
+    let coarse = ["--target-edges", "100", "--size", "1ft"];
+    let strips = |model: &str, bound: &str| {
+        let mut cmd = unfold_command();
+        cmd.arg(shared.join(model)).args(coarse);
+        cmd.args(["--scheme", "strip", "--max-deviation", bound]);
+        finish(cmd.arg("--out").arg(&out))
+    };
+    let cases = [
+        // (model, the fix named, whether it has holes)
+        ("fertility.obj", "use --scheme net", false),
+        (
+            "stanford-bunny.obj",
+            "(--fill-holes) or use --scheme net",
+            true,
+        ),
+    ];
+    for (model, fix, holes) in cases {
+        // Ten times the bound folds the same way: the advice is not to raise it.
+        for bound in ["5%", "50%"] {
+            let run = strips(model, bound);
+            let case = format!("{model} at {bound}");
+            assert_refusal(
+                &case,
+                &run,
+                1,
+                &["folds over its outline", "does not change that", fix],
+            );
+            assert!(!run.stderr.contains("may reach"), "{case}: {}", run.stderr);
+            assert_eq!(
+                run.stderr.contains("--fill-holes"),
+                holes,
+                "{case}: {}",
+                run.stderr
+            );
+            assert!(!out.exists(), "{case}: nothing written");
+        }
+        // What the refusal names builds.
+        let m = build("net", &shared.join(model), "1ft", &out, &coarse[..2]);
+        assert!(count(&m, "counts.panels") > 0, "{model}: net islands");
+        std::fs::remove_dir_all(&out).unwrap();
+    }
+}

@@ -376,8 +376,9 @@ fn covering(
 ) -> Result<Covering, SchemeError> {
     let within = |sector_length: f64| {
         strips_within(surface, field, tolerance, sector_length).map_err(|e| {
+            let fix = covering_fix(surface, &e);
             SchemeError::Model(format!(
-                "no strips within {tolerance:.3} mm of the model: {e}; a larger --max-deviation may reach"
+                "no strips within {tolerance:.3} mm of the model: {e}; {fix}"
             ))
         })
     };
@@ -396,6 +397,24 @@ fn covering(
         whole_bands,
         tolerance,
     })
+}
+
+/// How [`Cover::strips`] ends the error of a band that strays from the surface however
+/// narrow it is split: the one failure a larger bound can mend.
+const STAYS_OFF: &str = "mm from the surface";
+
+/// What to do where no strips cover `surface`, given why (`why`): a larger bound where
+/// a band strays however narrow; elsewhere (a band whose strip folds over its outline
+/// round a sharp corner however narrow, as on coarse or holed models) a larger bound
+/// changes nothing, and the net scheme's islands build.
+fn covering_fix(surface: &Triangles, why: &str) -> &'static str {
+    match (why.ends_with(STAYS_OFF), rims(surface).is_empty()) {
+        (true, _) => "a larger --max-deviation may reach",
+        (false, true) => "a larger --max-deviation does not change that: use --scheme net",
+        (false, false) => {
+            "a larger --max-deviation does not change that: close the model's holes (--fill-holes) or use --scheme net"
+        }
+    }
 }
 
 /// How much further than the estimate of what the strips strayed a narrower try
@@ -2071,7 +2090,7 @@ impl Cover {
             Ok((strip, d)) if d <= self.within => return Ok(vec![(strip, d)]),
             Ok((_, d)) if narrow => {
                 return Err(format!(
-                    "a band of the field {lo}..{hi} stays {d:.3} mm from the surface"
+                    "a band of the field {lo}..{hi} stays {d:.3} {STAYS_OFF}"
                 ))
             }
             Ok((_, d)) => d,
