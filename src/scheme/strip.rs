@@ -403,7 +403,7 @@ fn covering(
 /// narrow it is split: the one failure a larger bound can mend.
 const STAYS_OFF: &str = "mm from the surface";
 
-/// What to do where no strips cover `surface`, given why (`why`): a larger bound where
+/// What to do where no strips cover `surface`, given the reason `why`: a larger bound where
 /// a band strays however narrow; elsewhere (a band whose strip folds over its outline
 /// round a sharp corner however narrow, as on coarse or holed models) a larger bound
 /// changes nothing, and the net scheme's islands build.
