@@ -3037,26 +3037,33 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
         let zeros = zero.iter().map(|&v| (v, 0.0));
         zeros.chain(one.iter().map(|&v| (v, 1.0))).collect()
     };
+    // From every rim to the point farthest from them all (one rim, or holes in one
+    // side of the part, like a scan's base).
+    let from_rims = |rims: &[&Vec<u32>]| {
+        let from_rim = |v: u32| {
+            rims.iter()
+                .flat_map(|r| r.iter())
+                .map(|&r| at(r).distance(at(v)))
+                .fold(f64::INFINITY, f64::min)
+        };
+        let far = part
+            .iter()
+            .copied()
+            .max_by(|&a, &b| from_rim(a).total_cmp(&from_rim(b)).then(b.cmp(&a)))
+            .unwrap_or(part[0]);
+        let zero: Vec<u32> = rims.iter().flat_map(|r| r.iter().copied()).collect();
+        held(&zero, &[far])
+    };
     match in_part.as_slice() {
         [] => {
             let [one, other] = poles(points, part);
             held(&[one], &[other])
         }
-        // One rim: from it to the point farthest from it.
-        [rim] => {
-            let from_rim = |v: u32| {
-                rim.iter()
-                    .map(|&r| at(r).distance(at(v)))
-                    .fold(f64::INFINITY, f64::min)
-            };
-            let far = part
-                .iter()
-                .copied()
-                .max_by(|&a, &b| from_rim(a).total_cmp(&from_rim(b)).then(b.cmp(&a)))
-                .unwrap_or(part[0]);
-            held(rim, &[far])
-        }
-        // Several rims: the two whose centres lie farthest apart (an open tube's ends).
+        [_] => from_rims(&in_part),
+        // Several rims: the two whose centres lie farthest apart, where no point of the
+        // part lies farther from both than they lie from each other (an open tube's
+        // ends, an annulus's edges). Rims closer together than the rest of the part
+        // reaches are held as one: held apart, they would leave the field flat there.
         rims => {
             let centre = |r: &[u32]| r.iter().map(|&v| at(v)).sum::<DVec3>() / r.len() as f64;
             let mut best = (0, 1, f64::NEG_INFINITY);
@@ -3068,7 +3075,24 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
                     }
                 }
             }
-            held(rims[best.0], rims[best.1])
+            let (one, other) = (rims[best.0], rims[best.1]);
+            let nearest = |rim: &[u32], v: u32| {
+                rim.iter()
+                    .map(|&r| at(r).distance(at(v)))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let gap = one
+                .iter()
+                .map(|&v| nearest(other, v))
+                .fold(f64::INFINITY, f64::min);
+            let reach = part
+                .iter()
+                .map(|&v| nearest(one, v).min(nearest(other, v)))
+                .fold(0.0, f64::max);
+            match reach <= gap {
+                true => held(one, other),
+                false => from_rims(rims),
+            }
         }
     }
 }
@@ -3547,6 +3571,37 @@ mod tests {
         assert_eq!(check_strips(&tube, &field, 1.0), 1);
         let cone = super::tests::tube(32, 6, 120.0, |h| 60.0 - 0.3 * h);
         assert_eq!(check_strips(&cone, &two_pole_field(&cone).unwrap(), 1.0), 1);
+    }
+
+    #[test]
+    fn holes_close_together_are_one_pole_and_the_field_spans_the_rest() {
+        // A sphere with two holes 60 degrees apart round its lower part.
+        let mut holed = sphere(100.0, 24, 16);
+        let hole = |i: u32| [1 + 24 * 2 + i, 1 + 24 * 2 + i + 1, 1 + 24 * 3 + i + 1];
+        let removed = [hole(0), hole(4)];
+        holed
+            .corners
+            .retain(|t| !removed.iter().any(|h| h.iter().all(|v| t.contains(v))));
+        assert_eq!(rims(&holed).len(), 2);
+        let field = two_pole_field(&holed).unwrap();
+        let far = field.iter().position(|&f| f == 1.0).expect("a pole at 1");
+        assert!(
+            holed.points[far].z > 50.0,
+            "the pole at 1 is across from the holes"
+        );
+        for rim in rims(&holed) {
+            assert!(rim.iter().all(|&v| field[v as usize] == 0.0));
+        }
+        // Held apart, the two holes would leave the upper half flat.
+        let upper: Vec<f64> = (0..holed.points.len())
+            .filter(|&v| holed.points[v].z > 0.0)
+            .map(|v| field[v])
+            .collect();
+        let (lo, hi) = upper
+            .iter()
+            .fold((1.0f64, 0.0f64), |(lo, hi), &f| (lo.min(f), hi.max(f)));
+        assert!(hi - lo > 0.25, "the upper half spans {lo}..{hi}");
+        check_strips(&holed, &evened(&holed, &field), 2.0);
     }
 
     #[test]
