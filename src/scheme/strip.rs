@@ -3037,15 +3037,17 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
         let zeros = zero.iter().map(|&v| (v, 0.0));
         zeros.chain(one.iter().map(|&v| (v, 1.0))).collect()
     };
+    // The distance from point `v` to the nearest point of `rims`.
+    let nearest = |rims: &[&Vec<u32>], v: u32| {
+        rims.iter()
+            .flat_map(|r| r.iter())
+            .map(|&r| at(r).distance(at(v)))
+            .fold(f64::INFINITY, f64::min)
+    };
     // From every rim to the point farthest from them all (one rim, or holes in one
     // side of the part, like a scan's base).
     let from_rims = |rims: &[&Vec<u32>]| {
-        let from_rim = |v: u32| {
-            rims.iter()
-                .flat_map(|r| r.iter())
-                .map(|&r| at(r).distance(at(v)))
-                .fold(f64::INFINITY, f64::min)
-        };
+        let from_rim = |v: u32| nearest(rims, v);
         let far = part
             .iter()
             .copied()
@@ -3076,18 +3078,13 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
                 }
             }
             let (one, other) = (rims[best.0], rims[best.1]);
-            let nearest = |rim: &[u32], v: u32| {
-                rim.iter()
-                    .map(|&r| at(r).distance(at(v)))
-                    .fold(f64::INFINITY, f64::min)
-            };
             let gap = one
                 .iter()
-                .map(|&v| nearest(other, v))
+                .map(|&v| nearest(&[other], v))
                 .fold(f64::INFINITY, f64::min);
             let reach = part
                 .iter()
-                .map(|&v| nearest(one, v).min(nearest(other, v)))
+                .map(|&v| nearest(&[one, other], v))
                 .fold(0.0, f64::max);
             match reach <= gap {
                 true => held(one, other),
