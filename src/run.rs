@@ -975,7 +975,7 @@ fn build_manifest(
             panels: flat.len(),
             sheets: layout.sheets,
             sheets_lower_bound: lower_bound,
-            sheets_spacing_bound: nested.spacing_bound,
+            sheets_spacing_bound: nested.spacing_bound.max(lower_bound), // both hold: the larger
             holes: flat.iter().map(|p| p.holes.len()).sum(),
             connections: output.connections,
             connections_by_holes: manifest::connections_by_holes(flat, output.connections),
