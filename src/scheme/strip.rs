@@ -3,7 +3,7 @@
 //! between strips.
 //!
 //! The strips follow the level curves of a field between two poles of each part of
-//! the model (`two_pole_field`); between two neighbouring curves, the band of
+//! the model, or from its holes' rims (`two_pole_field`); between two neighbouring curves, the band of
 //! triangles that bends least (every corner on one of the two curves, so no vertex is
 //! inside the band and it unrolls exactly; the dynamic programme of the strip paper,
 //! `003`). A band whose strip strays from the model further than `--max-deviation`,
@@ -275,6 +275,10 @@ fn strip_panels(
     let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
     let bound = options.max_deviation.length((hi - lo).length());
     let surface = Triangles::from_mesh(mesh);
+    let surface = match ridged(&surface) {
+        true => surface.rims_apart(),
+        false => surface,
+    };
     let field = evened(
         &surface,
         &two_pole_field(&surface).map_err(SchemeError::Model)?,
@@ -749,7 +753,7 @@ impl Welded {
         }
         let mesh = crate::mesh::build::build_from_faces(positions, &faces).map_err(|e| {
             format!(
-                "the strips do not join into one surface ({e}); a different --max-deviation may"
+                "the strips do not join into one surface ({e}): a different --max-deviation may join them, or use --scheme net"
             )
         })?;
         let mut folds = Vec::new();
@@ -900,6 +904,46 @@ impl Triangles {
             points: mesh.positions().to_vec(),
             corners,
         }
+    }
+
+    /// The surface with every edge that joins two rim points across it (not along a
+    /// rim) split at its middle, the triangles beside it fanned from there: a distance
+    /// from the rims is 0 all along such an edge, and no level curve could run
+    /// between the rims it joins (a coarse model's holes, a triangle with its three
+    /// corners on a rim). The same surface, with more corners.
+    pub fn rims_apart(&self) -> Triangles {
+        let on_rim: std::collections::BTreeSet<u32> = rims(self).into_iter().flatten().collect();
+        let uses = edge_uses(&self.corners);
+        let mut points = self.points.clone();
+        let mut middles: BTreeMap<(u32, u32), u32> = BTreeMap::new();
+        for (&(a, b), &n) in &uses {
+            if n == 2 && on_rim.contains(&a) && on_rim.contains(&b) {
+                middles.insert((a, b), points.len() as u32);
+                points.push(0.5 * (self.points[a as usize] + self.points[b as usize]));
+            }
+        }
+        let mut corners = Vec::with_capacity(self.corners.len());
+        for t in &self.corners {
+            // The triangle's outline with its middles, fanned from its first middle.
+            let mut outline = Vec::with_capacity(6);
+            for (a, b) in cycle_pairs(t) {
+                outline.push(a);
+                outline.extend(middles.get(&(a.min(b), a.max(b))));
+            }
+            match outline
+                .iter()
+                .position(|&i| i as usize >= self.points.len())
+            {
+                None => corners.push(*t),
+                Some(first) => {
+                    outline.rotate_left(first);
+                    corners.extend(
+                        (1..outline.len() - 1).map(|k| [outline[0], outline[k], outline[k + 1]]),
+                    );
+                }
+            }
+        }
+        Triangles { points, corners }
     }
 
     /// The triangles by their corners' positions.
@@ -2004,6 +2048,7 @@ pub fn strips_within(
     let span = (hi - lo).max(1e-9);
     let spacing = tolerance / 3.0;
     let cover = Cover {
+        ridged: ridged(surface),
         within: tolerance,
         simplify: SIMPLIFY * tolerance,
         spacing,
@@ -2026,6 +2071,8 @@ pub fn strips_within(
 /// How [`strips_within`] covers the surface.
 #[derive(Clone, Copy)]
 struct Cover {
+    /// The field is a distance from rims, its saddles ridges ([`two_pole_field`]).
+    ridged: bool,
     /// The distance a strip may lie from its part, at any point.
     within: f64,
     /// Each curve keeps the fewest points within this of it.
@@ -2103,6 +2150,10 @@ impl Cover {
             true => (hi - lo) * (self.within / deviation).sqrt(),
             false => 0.25 * (hi - lo),
         };
+        let folding = Depth {
+            folds: true,
+            ..depth
+        };
         match self.sectors(patch) {
             Sectors::Cut(sectors) => {
                 let deeper = depth.deeper();
@@ -2125,14 +2176,7 @@ impl Cover {
                 }
                 // Every strip of some band folds over its outline (round a saddle):
                 // split it in two, taking such strips.
-                return self.split(
-                    patch,
-                    deviation,
-                    Depth {
-                        folds: true,
-                        ..depth
-                    },
-                );
+                return self.split(patch, deviation, folding);
             }
             // A cap grows from its pole (or up to it) in rings rather than being split:
             // split, its innermost band would be no wider than a cap can be.
@@ -2141,6 +2185,9 @@ impl Cover {
                     return Ok(covered);
                 }
             }
+            // Round a ridge of a distance field (where the rings round two rims meet)
+            // the levels have corners, and a band's strip folds there however narrow.
+            Sectors::Unfit if self.ridged => return self.split(patch, deviation, folding),
             Sectors::Unfit => {}
         }
         self.split(patch, deviation, depth)
@@ -2899,64 +2946,178 @@ fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
     best
 }
 
-/// The harmonic field of each connected part of `surface` between two poles (0 at
-/// one, 1 at the other, the cotangent Laplacian's zero elsewhere; faer's sparse
-/// Cholesky): level curves that run round the part like parallels between its ends,
-/// with saddles only where its shape needs them. The poles are the part's two points
-/// farthest apart or, on a part with rims, its rims ([`pole_values`]; an open tube's
-/// levels then run parallel to its rims).
+/// The field of each connected part of `surface`, from 0 to 1. On a closed part, or an
+/// open tube, the harmonic field between two poles (0 at one, 1 at the other, the
+/// cotangent Laplacian's zero elsewhere; faer's sparse Cholesky): level curves that
+/// run round the part like parallels between its ends, with saddles only where its
+/// shape needs them. The poles are the part's two points farthest apart, or the
+/// tube's rims. On a part with other rims (holes, like a scan's), the distance from
+/// them all ([`rim_distance`]): a harmonic field crowds its levels along a ragged rim
+/// or between two rims close together, too close for a strip between them.
 pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
     let n = surface.points.len();
     let weights = cotangent_weights(surface);
     let rims = rims(surface);
     let mut field = vec![0.0; n];
     for part in parts(surface) {
-        let fixed = pole_values(&surface.points, &part, &rims);
-        let mut index = vec![usize::MAX; n];
-        let free: Vec<u32> = part
-            .iter()
-            .copied()
-            .filter(|v| !fixed.contains_key(v))
-            .collect();
-        for (k, &v) in free.iter().enumerate() {
-            index[v as usize] = k;
-        }
-        let mut lower = Vec::new();
-        let mut rhs = vec![0.0; free.len()];
-        let mut diagonal = vec![0.0; free.len()];
-        for &(a, b, w) in &weights {
-            let (ia, ib) = (index[a as usize], index[b as usize]);
-            for (i, j, other) in [(ia, ib, b), (ib, ia, a)] {
-                if i == usize::MAX {
-                    continue;
-                }
-                diagonal[i] += w;
-                if j != usize::MAX {
-                    if j < i {
-                        lower.push(faer::sparse::Triplet::new(i, j, -w));
-                    }
-                } else if let Some(value) = fixed.get(&other) {
-                    rhs[i] += w * value;
-                }
-            }
-        }
-        // A hair on the diagonal keeps the system definite where weights vanish.
-        for (i, d) in diagonal.iter().enumerate() {
-            lower.push(faer::sparse::Triplet::new(
-                i,
-                i,
-                d + 1e-12 * d.abs().max(1.0),
-            ));
-        }
-        let solution = solve_lower(free.len(), &lower, &rhs)?;
-        for (&v, x) in free.iter().zip(solution) {
+        let values = match pole_values(&surface.points, &part, &rims) {
+            Held::Poles(fixed) => solve_on(n, &part, &weights, &fixed, &|_| 0.0, &|_| 0.0)?,
+            Held::Rims(rim) => rim_distance(surface, &part, &weights, &rim)?,
+        };
+        for (&v, x) in part.iter().zip(values) {
             field[v as usize] = x;
-        }
-        for (&v, &value) in &fixed {
-            field[v as usize] = value;
         }
     }
     Ok(field)
+}
+
+/// The values at the points of `part` (in its order) that solve
+/// `(K + diag(extra)) x = source` where they are free, `K` the Laplacian of `weights`,
+/// with the values `fixed` held (faer's sparse Cholesky).
+fn solve_on(
+    n: usize,
+    part: &[u32],
+    weights: &[(u32, u32, f64)],
+    fixed: &BTreeMap<u32, f64>,
+    extra: &dyn Fn(u32) -> f64,
+    source: &dyn Fn(u32) -> f64,
+) -> Result<Vec<f64>, String> {
+    let mut index = vec![usize::MAX; n];
+    let free: Vec<u32> = part
+        .iter()
+        .copied()
+        .filter(|v| !fixed.contains_key(v))
+        .collect();
+    for (k, &v) in free.iter().enumerate() {
+        index[v as usize] = k;
+    }
+    let mut lower = Vec::new();
+    let mut rhs: Vec<f64> = free.iter().map(|&v| source(v)).collect();
+    let mut diagonal: Vec<f64> = free.iter().map(|&v| extra(v)).collect();
+    for &(a, b, w) in weights {
+        let (ia, ib) = (index[a as usize], index[b as usize]);
+        for (i, j, other) in [(ia, ib, b), (ib, ia, a)] {
+            if i == usize::MAX {
+                continue;
+            }
+            diagonal[i] += w;
+            if j != usize::MAX {
+                if j < i {
+                    lower.push(faer::sparse::Triplet::new(i, j, -w));
+                }
+            } else if let Some(value) = fixed.get(&other) {
+                rhs[i] += w * value;
+            }
+        }
+    }
+    // A hair on the diagonal keeps the system definite where weights vanish.
+    for (i, d) in diagonal.iter().enumerate() {
+        lower.push(faer::sparse::Triplet::new(
+            i,
+            i,
+            d + 1e-12 * d.abs().max(1.0),
+        ));
+    }
+    let solution = solve_lower(free.len(), &lower, &rhs)?;
+    let mut values = vec![0.0; n];
+    for (&v, x) in free.iter().zip(solution) {
+        values[v as usize] = x;
+    }
+    for (&v, &value) in fixed {
+        values[v as usize] = value;
+    }
+    Ok(part.iter().map(|&v| values[v as usize]).collect())
+}
+
+/// How many screening lengths the heat of [`rim_distance`] crosses a part in: more,
+/// and it would fade below the solve's precision far from the rims.
+const HEAT_REACH: f64 = 25.0;
+
+/// The distance over `part` from its points `rim` (the heat method: heat held on the
+/// rims spreads a short way, its flow's direction, made unit, is the distance's
+/// gradient, and a Poisson solve with the rims at 0 gives the distance), scaled to 1
+/// at its farthest point. Its levels near a rim run along it at a constant distance
+/// however the rim is ragged or near another, where a harmonic field's crowd.
+fn rim_distance(
+    surface: &Triangles,
+    part: &[u32],
+    weights: &[(u32, u32, f64)],
+    rim: &[u32],
+) -> Result<Vec<f64>, String> {
+    let n = surface.points.len();
+    let at = |v: u32| surface.points[v as usize];
+    let in_part = {
+        let mut flags = vec![false; n];
+        for &v in part {
+            flags[v as usize] = true;
+        }
+        flags
+    };
+    let triangles: Vec<[u32; 3]> = surface
+        .corners
+        .iter()
+        .copied()
+        .filter(|t| in_part[t[0] as usize])
+        .collect();
+    let (lo, hi) = crate::mesh::geometry::bounding_box(part.iter().map(|&v| at(v)));
+    let screening = (hi - lo).length() / HEAT_REACH;
+    let mut mass = vec![0.0; n];
+    for t in &triangles {
+        let [a, b, c] = t.map(at);
+        let third = (b - a).cross(c - a).length() / 6.0;
+        for &v in t {
+            mass[v as usize] += third;
+        }
+    }
+    let hot: BTreeMap<u32, f64> = rim.iter().map(|&v| (v, 1.0)).collect();
+    let heat = solve_on(
+        n,
+        part,
+        weights,
+        &hot,
+        &|v| mass[v as usize] / (screening * screening),
+        &|_| 0.0,
+    )?;
+    let mut u = vec![0.0; n];
+    for (&v, x) in part.iter().zip(heat) {
+        u[v as usize] = x;
+    }
+    // The divergence at each point of the unit field pointing away from the heat.
+    let mut divergence = vec![0.0; n];
+    for t in &triangles {
+        let [a, b, c] = t.map(at);
+        let normal = (b - a).cross(c - a);
+        let twice = normal.length();
+        if twice <= 0.0 {
+            continue;
+        }
+        let unit = normal / twice;
+        let [ua, ub, uc] = t.map(|v| u[v as usize]);
+        let gradient =
+            (ua * unit.cross(c - b) + ub * unit.cross(a - c) + uc * unit.cross(b - a)) / twice;
+        let away = -gradient.normalize_or_zero();
+        for k in 0..3 {
+            let (i, j, l) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let [pi, pj, pl] = [i, j, l].map(at);
+            let cot = |apex: DVec3, p: DVec3, q: DVec3| {
+                let (x, y) = (p - apex, q - apex);
+                (x.dot(y) / x.cross(y).length().max(1e-300)).clamp(-1e3, 1e3)
+            };
+            divergence[i as usize] += 0.5
+                * (cot(pl, pi, pj) * (pj - pi).dot(away) + cot(pj, pl, pi) * (pl - pi).dot(away));
+        }
+    }
+    let cold: BTreeMap<u32, f64> = rim.iter().map(|&v| (v, 0.0)).collect();
+    // The Laplacian of the distance is the divergence: K, the negative Laplacian,
+    // takes its negative.
+    let distance = solve_on(n, part, weights, &cold, &|_| 0.0, &|v| {
+        -divergence[v as usize]
+    })?;
+    let far = distance.iter().copied().fold(0.0, f64::max);
+    Ok(match far > 0.0 {
+        true => distance.iter().map(|d| d.max(0.0) / far).collect(),
+        false => distance,
+    })
 }
 
 /// Bins of field values over which [`evened`] measures the surface's width per value.
@@ -3024,18 +3185,26 @@ pub fn evened(surface: &Triangles, field: &[f64]) -> Vec<f64> {
         .collect()
 }
 
-/// The field's fixed values on `part`: 0 and 1 at its two points farthest apart on a
-/// closed part; on a part with one rim, 0 on it and 1 at the point farthest from it;
-/// with more, 0 and 1 on the two rims whose centres lie farthest apart.
-fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u32, f64> {
+/// How the field is held on a part.
+enum Held {
+    /// At these values at these points, harmonic between.
+    Poles(BTreeMap<u32, f64>),
+    /// At 0 on these rim points, the distance from them elsewhere.
+    Rims(Vec<u32>),
+}
+
+/// How the field is held on `part`: at 0 and 1 at its two points farthest apart on a
+/// closed part, or on its two rims on an open tube or an annulus; else at 0 on all its
+/// rims, the distance from them elsewhere.
+fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> Held {
     let in_part: Vec<&Vec<u32>> = rims
         .iter()
         .filter(|r| part.binary_search(&r[0]).is_ok())
         .collect();
     let at = |v: u32| points[v as usize];
-    let held = |zero: &[u32], one: &[u32]| -> BTreeMap<u32, f64> {
+    let held = |zero: &[u32], one: &[u32]| {
         let zeros = zero.iter().map(|&v| (v, 0.0));
-        zeros.chain(one.iter().map(|&v| (v, 1.0))).collect()
+        Held::Poles(zeros.chain(one.iter().map(|&v| (v, 1.0))).collect())
     };
     // The distance from point `v` to the nearest point of `rims`.
     let nearest = |rims: &[&Vec<u32>], v: u32| {
@@ -3044,18 +3213,10 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
             .map(|&r| at(r).distance(at(v)))
             .fold(f64::INFINITY, f64::min)
     };
-    // From every rim to the point farthest from them all (one rim, or holes in one
-    // side of the part, like a scan's base).
-    let from_rims = |rims: &[&Vec<u32>]| {
-        let from_rim = |v: u32| nearest(rims, v);
-        let far = part
-            .iter()
-            .copied()
-            .max_by(|&a, &b| from_rim(a).total_cmp(&from_rim(b)).then(b.cmp(&a)))
-            .unwrap_or(part[0]);
-        let zero: Vec<u32> = rims.iter().flat_map(|r| r.iter().copied()).collect();
-        held(&zero, &[far])
-    };
+    // The distance from every rim (one rim, or holes in one side of the part, like a
+    // scan's base).
+    let from_rims =
+        |rims: &[&Vec<u32>]| Held::Rims(rims.iter().flat_map(|r| r.iter().copied()).collect());
     match in_part.as_slice() {
         [] => {
             let [one, other] = poles(points, part);
@@ -3092,6 +3253,15 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> BTreeMap<u3
             }
         }
     }
+}
+
+/// Whether [`two_pole_field`] gives some part of `surface` the distance from its rims.
+fn ridged(surface: &Triangles) -> bool {
+    let rims = rims(surface);
+    !rims.is_empty()
+        && parts(surface)
+            .iter()
+            .any(|part| matches!(pole_values(&surface.points, part, &rims), Held::Rims(_)))
 }
 
 /// The rims of `surface`: loops of the edges only one triangle uses, each as its
@@ -3598,6 +3768,92 @@ mod tests {
             .iter()
             .fold((1.0f64, 0.0f64), |(lo, hi), &f| (lo.min(f), hi.max(f)));
         assert!(hi - lo > 0.25, "the upper half spans {lo}..{hi}");
+        check_strips(&holed, &evened(&holed, &field), 2.0);
+    }
+
+    #[test]
+    fn the_field_of_a_part_with_holes_runs_at_even_distances_along_their_rims() {
+        // Three ragged holes side by side in a sphere's base, 11 mm apart at their
+        // nearest: a field held at 0 on them must rise as fast all round each rim.
+        let mut holed = sphere(100.0, 96, 48);
+        let centres =
+            [-35.0, 0.0, 35.0].map(|x: f64| DVec3::new(x, 0.0, -(100.0f64 * 100.0 - x * x).sqrt()));
+        let points = holed.points.clone();
+        holed.corners.retain(|t| {
+            let middle = t.iter().map(|&v| points[v as usize]).sum::<DVec3>() / 3.0;
+            centres.iter().all(|c| middle.distance(*c) > 12.0)
+        });
+        let holed = holed.rims_apart();
+        assert_eq!(rims(&holed).len(), 3);
+        let field = two_pole_field(&holed).unwrap();
+        let segments: Vec<(DVec3, DVec3)> = rims(&holed)
+            .iter()
+            .flat_map(|r| {
+                cycle_pairs(r)
+                    .map(|(a, b)| (holed.points[a as usize], holed.points[b as usize]))
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let to_rims = |p: DVec3| {
+            segments
+                .iter()
+                .map(|&(a, b)| {
+                    let t = ((p - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+                    p.distance(a + t * (b - a))
+                })
+                .fold(f64::INFINITY, f64::min)
+        };
+        // How much faster the field rises than the distance, 8 to 20 mm out, at its
+        // fastest over its slowest.
+        let used: std::collections::BTreeSet<u32> =
+            holed.corners.iter().flatten().copied().collect();
+        let spread = |field: &[f64]| {
+            let ratios: Vec<f64> = used
+                .iter()
+                .filter_map(|&v| {
+                    let d = to_rims(holed.points[v as usize]);
+                    (8.0..20.0).contains(&d).then(|| field[v as usize] / d)
+                })
+                .collect();
+            assert!(ratios.len() > 100, "{} points near the rims", ratios.len());
+            let (lo, hi) = ratios.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
+                (lo.min(r), hi.max(r))
+            });
+            hi / lo
+        };
+        // The harmonic field from the rims to the point farthest from them crowds its
+        // levels by a factor of three here; the distance keeps within two, its
+        // smoothing slowing it between two holes.
+        let part = &parts(&holed)[0];
+        let on_rims: Vec<u32> = rims(&holed).into_iter().flatten().collect();
+        let far = *used
+            .iter()
+            .max_by(|&&a, &&b| {
+                let d = |v: u32| to_rims(holed.points[v as usize]);
+                d(a).total_cmp(&d(b))
+            })
+            .unwrap();
+        let held: BTreeMap<u32, f64> = on_rims
+            .iter()
+            .map(|&v| (v, 0.0))
+            .chain([(far, 1.0)])
+            .collect();
+        let n = holed.points.len();
+        let weights = cotangent_weights(&holed);
+        let values = solve_on(n, part, &weights, &held, &|_| 0.0, &|_| 0.0).unwrap();
+        let mut harmonic = vec![0.0; n];
+        for (&v, x) in part.iter().zip(values) {
+            harmonic[v as usize] = x;
+        }
+        let (distance, crowded) = (spread(&field), spread(&harmonic));
+        assert!(
+            distance < 2.0,
+            "the distance rises {distance} times faster in places"
+        );
+        assert!(
+            crowded > 3.0,
+            "the harmonic field rises {crowded} times faster"
+        );
         check_strips(&holed, &evened(&holed, &field), 2.0);
     }
 
