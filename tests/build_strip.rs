@@ -480,6 +480,22 @@ fn models_with_holes_are_strips_within_the_bound() {
 }
 
 #[test]
+fn a_model_with_legs_is_strips_within_the_bound() {
+    // Between its two points farthest apart, a harmonic field stays level along the
+    // horse's legs, too flat to split; the distance from one of them rises along them.
+    let Some(shared) = shared_models("a_model_with_legs_is_strips_within_the_bound") else {
+        return;
+    };
+    let tmp = TempDir::new().unwrap();
+    let horse = shared.join("horse_quad.obj");
+    let m = strip_build(&horse, "4ft", "0.5%", &tmp.path().join("out"));
+    let job = strip_job(&horse, "4ft", "0.5%", &tmp.path().join("job"));
+    let (strips, pieces) = check_strips("horse", &job, num(&m, "strip.max_deviation"));
+    assert!(strips > 1, "{strips} strips");
+    assert_eq!(count(&m, "strip.pieces"), pieces);
+}
+
+#[test]
 fn strips_are_the_same_bytes_on_one_and_two_threads() {
     let tmp = TempDir::new().unwrap();
     let model = torus(tmp.path(), 24, 12, 80.0, 30.0);

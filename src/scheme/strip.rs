@@ -275,28 +275,22 @@ fn strip_panels(
     let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
     let bound = options.max_deviation.length((hi - lo).length());
     let surface = Triangles::from_mesh(mesh);
-    let surface = match ridged(&surface) {
-        true => surface.rims_apart(),
-        false => surface,
-    };
-    let field = evened(
-        &surface,
-        &two_pole_field(&surface).map_err(SchemeError::Model)?,
-    );
     let limit = options.net.panel.panel_limit;
     // Bands are cut across into sectors about as long as the sheet's shorter side: an
     // unrolled sector is an arc, and shorter arcs nest closer (docs/benchmarks.md).
     let sector_length = limit.map_or(f64::INFINITY, |l| l.width.min(l.height));
     // A strip longer than the sheet's longer side is cut into equal pieces no longer.
     let piece_length = limit.map_or(f64::INFINITY, |l| l.width.max(l.height));
-    let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length);
-    let (covered, measured) = match unsimplified {
-        None => {
-            let covered = cover(bound)?;
-            let measured = covered.banded.deviation;
-            (covered, measured)
+    let covered_with =
+        |closed: Closed| covered_with(&surface, closed, bound, unsimplified, sector_length);
+    // A harmonic field between two poles stays nearly level along a dead end (a
+    // horse's legs), too flat to split into bands; the distance from one pole rises
+    // along every branch. The first failure is the one told.
+    let (covered, measured) = match covered_with(Closed::Harmonic) {
+        Err(SchemeError::Model(why)) if closed_part(&surface) => {
+            covered_with(Closed::Distance).map_err(|_| SchemeError::Model(why))?
         }
-        Some(unsimplified) => within_unsimplified(bound, &surface.soup(), unsimplified, &cover)?,
+        other => other?,
     };
     let Covering {
         banded,
@@ -360,6 +354,36 @@ fn strip_panels(
     Ok(output)
 }
 
+/// The strips of `surface` within `bound` of the model (of `unsimplified`, where the
+/// surface was simplified from it), with `closed` parts' field, and the largest
+/// distance measured.
+fn covered_with(
+    surface: &Triangles,
+    closed: Closed,
+    bound: f64,
+    unsimplified: Option<&[[DVec3; 3]]>,
+    sector_length: f64,
+) -> Result<(Covering, f64), SchemeError> {
+    let ridged = ridged(surface, closed);
+    let surface = match ridged {
+        true => surface.rims_apart(),
+        false => surface.clone(),
+    };
+    let field = evened(
+        &surface,
+        &field_of(&surface, closed).map_err(SchemeError::Model)?,
+    );
+    let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length, ridged);
+    match unsimplified {
+        None => {
+            let covered = cover(bound)?;
+            let measured = covered.banded.deviation;
+            Ok((covered, measured))
+        }
+        Some(unsimplified) => within_unsimplified(bound, &surface.soup(), unsimplified, &cover),
+    }
+}
+
 /// The strips of a surface within a tolerance, welded.
 struct Covering {
     banded: Banded,
@@ -377,9 +401,10 @@ fn covering(
     field: &[f64],
     tolerance: f64,
     sector_length: f64,
+    ridged: bool,
 ) -> Result<Covering, SchemeError> {
     let within = |sector_length: f64| {
-        strips_within(surface, field, tolerance, sector_length).map_err(|e| {
+        strips_ridged(surface, field, tolerance, sector_length, ridged).map_err(|e| {
             let fix = covering_fix(surface, &e);
             SchemeError::Model(format!(
                 "no strips within {tolerance:.3} mm of the model: {e}; {fix}"
@@ -2037,6 +2062,18 @@ pub fn strips_within(
     tolerance: f64,
     sector_length: f64,
 ) -> Result<Banded, String> {
+    let ridged = ridged(surface, Closed::Harmonic);
+    strips_ridged(surface, field, tolerance, sector_length, ridged)
+}
+
+/// [`strips_within`], where the field has ridges (a distance's, [`field_of`]) or not.
+fn strips_ridged(
+    surface: &Triangles,
+    field: &[f64],
+    tolerance: f64,
+    sector_length: f64,
+    ridged: bool,
+) -> Result<Banded, String> {
     let (lo, hi) = field
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
@@ -2048,7 +2085,7 @@ pub fn strips_within(
     let span = (hi - lo).max(1e-9);
     let spacing = tolerance / 3.0;
     let cover = Cover {
-        ridged: ridged(surface),
+        ridged,
         within: tolerance,
         simplify: SIMPLIFY * tolerance,
         spacing,
@@ -2952,17 +2989,31 @@ fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
 /// run round the part like parallels between its ends, with saddles only where its
 /// shape needs them. The poles are the part's two points farthest apart, or the
 /// tube's rims. On a part with other rims (holes, like a scan's), the distance from
-/// them all ([`rim_distance`]): a harmonic field crowds its levels along a ragged rim
+/// them all ([`distance_from`]): a harmonic field crowds its levels along a ragged rim
 /// or between two rims close together, too close for a strip between them.
 pub fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
+    field_of(surface, Closed::Harmonic)
+}
+
+/// What the field is on a closed part.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Closed {
+    /// Harmonic between its two points farthest apart.
+    Harmonic,
+    /// The distance from the first of them ([`distance_from`]).
+    Distance,
+}
+
+/// [`two_pole_field`], with `closed` parts' field as asked.
+fn field_of(surface: &Triangles, closed: Closed) -> Result<Vec<f64>, String> {
     let n = surface.points.len();
     let weights = cotangent_weights(surface);
     let rims = rims(surface);
     let mut field = vec![0.0; n];
     for part in parts(surface) {
-        let values = match pole_values(&surface.points, &part, &rims) {
+        let values = match pole_values(&surface.points, &part, &rims, closed) {
             Held::Poles(fixed) => solve_on(n, &part, &weights, &fixed, &|_| 0.0, &|_| 0.0)?,
-            Held::Rims(rim) => rim_distance(surface, &part, &weights, &rim)?,
+            Held::Distance(from) => distance_from(surface, &part, &weights, &from)?,
         };
         for (&v, x) in part.iter().zip(values) {
             field[v as usize] = x;
@@ -3029,20 +3080,22 @@ fn solve_on(
     Ok(part.iter().map(|&v| values[v as usize]).collect())
 }
 
-/// How many screening lengths the heat of [`rim_distance`] crosses a part in: more,
+/// How many screening lengths the heat of [`distance_from`] crosses a part in: more,
 /// and it would fade below the solve's precision far from the rims.
 const HEAT_REACH: f64 = 25.0;
 
-/// The distance over `part` from its points `rim` (the heat method: heat held on the
-/// rims spreads a short way, its flow's direction, made unit, is the distance's
-/// gradient, and a Poisson solve with the rims at 0 gives the distance), scaled to 1
-/// at its farthest point. Its levels near a rim run along it at a constant distance
-/// however the rim is ragged or near another, where a harmonic field's crowd.
-fn rim_distance(
+/// The distance over `part` from its points `from` (its rims, or a pole), by the heat
+/// method: heat held on them spreads a short way, its flow's direction, made unit, is
+/// the distance's gradient, and a Poisson solve with them at 0 gives the distance,
+/// scaled to 1 at its farthest point. Its levels near a rim run along it at a constant
+/// distance however the rim is ragged or near another, where a harmonic field's crowd,
+/// and they rise along every branch of a part, where a harmonic field between two
+/// poles stays level along a dead end.
+fn distance_from(
     surface: &Triangles,
     part: &[u32],
     weights: &[(u32, u32, f64)],
-    rim: &[u32],
+    from: &[u32],
 ) -> Result<Vec<f64>, String> {
     let n = surface.points.len();
     let at = |v: u32| surface.points[v as usize];
@@ -3069,7 +3122,7 @@ fn rim_distance(
             mass[v as usize] += third;
         }
     }
-    let hot: BTreeMap<u32, f64> = rim.iter().map(|&v| (v, 1.0)).collect();
+    let hot: BTreeMap<u32, f64> = from.iter().map(|&v| (v, 1.0)).collect();
     let heat = solve_on(
         n,
         part,
@@ -3107,7 +3160,7 @@ fn rim_distance(
                 * (cot(pl, pi, pj) * (pj - pi).dot(away) + cot(pj, pl, pi) * (pl - pi).dot(away));
         }
     }
-    let cold: BTreeMap<u32, f64> = rim.iter().map(|&v| (v, 0.0)).collect();
+    let cold: BTreeMap<u32, f64> = from.iter().map(|&v| (v, 0.0)).collect();
     // The Laplacian of the distance is the divergence: K, the negative Laplacian,
     // takes its negative.
     let distance = solve_on(n, part, weights, &cold, &|_| 0.0, &|v| {
@@ -3189,14 +3242,14 @@ pub fn evened(surface: &Triangles, field: &[f64]) -> Vec<f64> {
 enum Held {
     /// At these values at these points, harmonic between.
     Poles(BTreeMap<u32, f64>),
-    /// At 0 on these rim points, the distance from them elsewhere.
-    Rims(Vec<u32>),
+    /// At 0 at these points (rims, or a pole), the distance from them elsewhere.
+    Distance(Vec<u32>),
 }
 
 /// How the field is held on `part`: at 0 and 1 at its two points farthest apart on a
 /// closed part, or on its two rims on an open tube or an annulus; else at 0 on all its
 /// rims, the distance from them elsewhere.
-fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> Held {
+fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>], closed: Closed) -> Held {
     let in_part: Vec<&Vec<u32>> = rims
         .iter()
         .filter(|r| part.binary_search(&r[0]).is_ok())
@@ -3216,12 +3269,12 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> Held {
     // The distance from every rim (one rim, or holes in one side of the part, like a
     // scan's base).
     let from_rims =
-        |rims: &[&Vec<u32>]| Held::Rims(rims.iter().flat_map(|r| r.iter().copied()).collect());
+        |rims: &[&Vec<u32>]| Held::Distance(rims.iter().flat_map(|r| r.iter().copied()).collect());
     match in_part.as_slice() {
-        [] => {
-            let [one, other] = poles(points, part);
-            held(&[one], &[other])
-        }
+        [] => match (poles(points, part), closed) {
+            ([one, other], Closed::Harmonic) => held(&[one], &[other]),
+            ([one, _], Closed::Distance) => Held::Distance(vec![one]),
+        },
         [_] => from_rims(&in_part),
         // Several rims: the two whose centres lie farthest apart, where no point of the
         // part lies farther from both than they lie from each other (an open tube's
@@ -3255,13 +3308,23 @@ fn pole_values(points: &[DVec3], part: &[u32], rims: &[Vec<u32>]) -> Held {
     }
 }
 
-/// Whether [`two_pole_field`] gives some part of `surface` the distance from its rims.
-fn ridged(surface: &Triangles) -> bool {
+/// Whether [`field_of`] gives some part of `surface` a distance.
+fn ridged(surface: &Triangles, closed: Closed) -> bool {
     let rims = rims(surface);
-    !rims.is_empty()
-        && parts(surface)
-            .iter()
-            .any(|part| matches!(pole_values(&surface.points, part, &rims), Held::Rims(_)))
+    parts(surface).iter().any(|part| {
+        matches!(
+            pole_values(&surface.points, part, &rims, closed),
+            Held::Distance(_)
+        )
+    })
+}
+
+/// Whether some part of `surface` has no rim.
+fn closed_part(surface: &Triangles) -> bool {
+    let rims = rims(surface);
+    parts(surface)
+        .iter()
+        .any(|part| !rims.iter().any(|r| part.binary_search(&r[0]).is_ok()))
 }
 
 /// The rims of `surface`: loops of the edges only one triangle uses, each as its
