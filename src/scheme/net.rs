@@ -813,6 +813,26 @@ struct Obstacle<'a> {
     need: f64,
 }
 
+/// The least step between two corners of a tab cut back (mm).
+const TAB_STEP: f64 = 1e-3;
+
+/// The points of `top` (from `from` round to `to`) more than [`TAB_STEP`] from the one
+/// before and from `to`: a point the clipping left within a micron of its neighbour
+/// is that one, for written to the sheet, so short a step could turn the outline back
+/// on itself.
+fn stepped(top: impl Iterator<Item = DVec2>, from: DVec2, to: DVec2) -> Vec<DVec2> {
+    let mut kept: Vec<DVec2> = Vec::new();
+    for q in top {
+        if q.distance(*kept.last().unwrap_or(&from)) > TAB_STEP {
+            kept.push(q);
+        }
+    }
+    while kept.last().is_some_and(|&q| q.distance(to) <= TAB_STEP) {
+        kept.pop();
+    }
+    kept
+}
+
 /// `tab` cut back to keep clear of `obstacles`: each one it comes too near is cut
 /// away along that obstacle's side that leaves the most of the tab. `None` when less
 /// than half its base or under a third of its area is left. The tab's flat outline
@@ -876,11 +896,14 @@ fn clear_tab(
     }
     // Counter-clockwise from a' round the top back to b'.
     let n = poly.len();
-    let top: Vec<DVec2> = (1..n)
-        .map(|k| poly[(a_end + k) % n])
-        .take_while(|&q| !on_base(q) || q != poly[b_end])
-        .filter(|&q| !on_base(q))
-        .collect();
+    let top = stepped(
+        (1..n)
+            .map(|k| poly[(a_end + k) % n])
+            .take_while(|&q| !on_base(q) || q != poly[b_end])
+            .filter(|&q| !on_base(q)),
+        poly[a_end],
+        poly[b_end],
+    );
     if top.is_empty() {
         return None;
     }
