@@ -2345,7 +2345,7 @@ impl Cover {
         // saddle the sectors would not be bands.
         let ring = loops.len() == 2 && *closed && upper == 1;
         let disk = loops.len() == 1 && upper == 1;
-        if !ring && !disk {
+        if !ring && !disk || inner_extremum(patch, &loops) {
             return Sectors::Unfit;
         }
         let across = Across::new(patch, &loops);
@@ -2498,6 +2498,26 @@ impl Cover {
         points.dedup();
         points
     }
+}
+
+/// Whether the field has an extremum at a point of `patch` inside its outline `loops`
+/// (the top of a bump, in a distance field): the patch is then no band, for its levels
+/// ring the bump too and meet the band's at a saddle.
+fn inner_extremum(patch: &Patch, loops: &[Vec<u32>]) -> bool {
+    let outline: std::collections::BTreeSet<u32> = loops.iter().flatten().copied().collect();
+    let n = patch.values.len();
+    let (mut higher, mut lower) = (vec![false; n], vec![false; n]);
+    for t in &patch.surface.corners {
+        for (a, b) in cycle_pairs(t) {
+            let (va, vb) = (patch.values[a as usize], patch.values[b as usize]);
+            higher[a as usize] |= vb > va;
+            lower[a as usize] |= vb < va;
+        }
+    }
+    let used: std::collections::BTreeSet<u32> =
+        patch.surface.corners.iter().flatten().copied().collect();
+    used.iter()
+        .any(|&v| !outline.contains(&v) && (!higher[v as usize] || !lower[v as usize]))
 }
 
 /// The ways across a patch: its edges between two of its triangles, each upward into
@@ -3918,6 +3938,42 @@ mod tests {
             "the harmonic field rises {crowded} times faster"
         );
         check_strips(&holed, &evened(&holed, &field), 2.0);
+    }
+
+    #[test]
+    fn a_bump_inside_a_patch_is_an_extremum_and_its_outline_is_not() {
+        // A 5 x 5 grid rising along x, its middle point raised above its neighbours.
+        let points: Vec<DVec3> = (0..25)
+            .map(|k| DVec3::new((k % 5) as f64, (k / 5) as f64, 0.0))
+            .collect();
+        let mut corners = Vec::new();
+        for y in 0..4u32 {
+            for x in 0..4u32 {
+                let k = 5 * y + x;
+                corners.extend([[k, k + 1, k + 6], [k, k + 6, k + 5]]);
+            }
+        }
+        let rising: Vec<f64> = points.iter().map(|p| p.x).collect();
+        let patch = |values: Vec<f64>| Patch {
+            surface: Triangles {
+                points: points.clone(),
+                corners: corners.clone(),
+            },
+            values,
+            kept: vec![true; 25],
+            ends: [0.0, 4.0],
+        };
+        let loops =
+            |p: &Patch| boundary_loops(p.surface.corners.iter().flat_map(|t| cycle_pairs(t)));
+        let plain = patch(rising.clone());
+        assert!(
+            !inner_extremum(&plain, &loops(&plain)),
+            "the outline's ends are no bump"
+        );
+        let mut bumped = rising;
+        bumped[12] = 3.5;
+        let bumped = patch(bumped);
+        assert!(inner_extremum(&bumped, &loops(&bumped)));
     }
 
     #[test]
