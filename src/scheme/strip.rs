@@ -3158,26 +3158,16 @@ fn distance_from(
     // The divergence at each point of the unit field pointing away from the heat.
     let mut divergence = vec![0.0; n];
     for t in &triangles {
-        let [a, b, c] = t.map(at);
-        let normal = (b - a).cross(c - a);
-        let twice = normal.length();
-        if twice <= 0.0 {
+        let Some((gradient, _)) = gradient_on(t.map(at), t.map(|v| u[v as usize])) else {
             continue;
-        }
-        let unit = normal / twice;
-        let [ua, ub, uc] = t.map(|v| u[v as usize]);
-        let gradient =
-            (ua * unit.cross(c - b) + ub * unit.cross(a - c) + uc * unit.cross(b - a)) / twice;
+        };
         let away = -gradient.normalize_or_zero();
         for k in 0..3 {
             let (i, j, l) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
             let [pi, pj, pl] = [i, j, l].map(at);
-            let cot = |apex: DVec3, p: DVec3, q: DVec3| {
-                let (x, y) = (p - apex, q - apex);
-                (x.dot(y) / x.cross(y).length().max(1e-300)).clamp(-1e3, 1e3)
-            };
             divergence[i as usize] += 0.5
-                * (cot(pl, pi, pj) * (pj - pi).dot(away) + cot(pj, pl, pi) * (pl - pi).dot(away));
+                * (cotangent(pl, pi, pj) * (pj - pi).dot(away)
+                    + cotangent(pj, pl, pi) * (pl - pi).dot(away));
         }
     }
     let cold: BTreeMap<u32, f64> = from.iter().map(|&v| (v, 0.0)).collect();
@@ -3217,16 +3207,12 @@ pub fn evened(surface: &Triangles, field: &[f64]) -> Vec<f64> {
     let mut area = vec![0.0; EVEN_BINS];
     let mut area_gradient = vec![0.0; EVEN_BINS];
     for t in &surface.corners {
-        let [a, b, c] = t.map(|i| surface.points[i as usize]);
         let [fa, fb, fc] = t.map(|i| field[i as usize]);
-        let normal = (b - a).cross(c - a);
-        let twice = normal.length();
-        if twice <= 0.0 {
+        let Some((gradient, twice)) =
+            gradient_on(t.map(|i| surface.points[i as usize]), [fa, fb, fc])
+        else {
             continue;
-        }
-        let n = normal / twice;
-        // ∇f = Σ f_i (n × e_i) / 2A, e_i the side opposite corner i, counter-clockwise.
-        let gradient = (fa * n.cross(c - b) + fb * n.cross(a - c) + fc * n.cross(b - a)) / twice;
+        };
         let g = gradient.length();
         let (first, last) = (bin(fa.min(fb).min(fc)), bin(fa.max(fb).max(fc)));
         let share = 0.5 * twice / (last - first + 1) as f64;
@@ -3407,6 +3393,27 @@ fn solve_lower(
 /// The least weight an edge keeps in the field's system.
 const LEAST_WEIGHT: f64 = 1e-6;
 
+/// The cotangent of the angle at `apex` between `p` and `q`, kept within ±1000 (a
+/// needle triangle's would swamp the rest).
+fn cotangent(apex: DVec3, p: DVec3, q: DVec3) -> f64 {
+    let (u, v) = (p - apex, q - apex);
+    (u.dot(v) / u.cross(v).length().max(1e-300)).clamp(-1e3, 1e3)
+}
+
+/// The gradient over the triangle `[a, b, c]` (counter-clockwise) of the linear
+/// function with values `f` at its corners, and twice its area; `None` where it has
+/// none. ∇f = Σ f_i (n × e_i) / 2A, e_i the side opposite corner i.
+fn gradient_on([a, b, c]: [DVec3; 3], [fa, fb, fc]: [f64; 3]) -> Option<(DVec3, f64)> {
+    let normal = (b - a).cross(c - a);
+    let twice = normal.length();
+    if twice <= 0.0 {
+        return None;
+    }
+    let n = normal / twice;
+    let gradient = (fa * n.cross(c - b) + fb * n.cross(a - c) + fc * n.cross(b - a)) / twice;
+    Some((gradient, twice))
+}
+
 /// Each edge of `surface` (once, lower corner first) with its cotangent weight: half
 /// the sum of the cotangents of the angles facing it, each kept within ±1000 (a
 /// needle triangle's would swamp the rest), the sum at least [`LEAST_WEIGHT`].
@@ -3416,9 +3423,7 @@ fn cotangent_weights(surface: &Triangles) -> Vec<(u32, u32, f64)> {
         for k in 0..3 {
             let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
             let [pa, pb, pc] = [a, b, c].map(|i| surface.points[i as usize]);
-            let (u, v) = (pa - pc, pb - pc);
-            let cot = (u.dot(v) / u.cross(v).length().max(1e-300)).clamp(-1e3, 1e3);
-            *weights.entry((a.min(b), a.max(b))).or_insert(0.0) += 0.5 * cot;
+            *weights.entry((a.min(b), a.max(b))).or_insert(0.0) += 0.5 * cotangent(pc, pa, pb);
         }
     }
     // Negative weights (obtuse angles) kept a hair above zero: the system stays
