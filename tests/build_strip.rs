@@ -470,21 +470,19 @@ fn models_with_holes_are_strips_within_the_bound() {
     let simplified = simplified_obj(&bunny, 20_000, false, tmp.path());
     for path in [shared.join("teapot.obj"), bunny, simplified] {
         let model = &path.file_name().unwrap().to_string_lossy().into_owned();
-        let m = strip_build(
-            &path,
-            "4ft",
-            "0.5%",
-            &tmp.path().join(format!("{model}.out")),
-        );
-        let job = strip_job(&path, "4ft", "0.5%", &tmp.path().join("job"));
-        let (strips, pieces) = check_strips(model, &job, num(&m, "strip.max_deviation"));
-        assert!(strips > 1, "{model}: {strips} strips");
-        assert_eq!(
-            count(&m, "strip.pieces"),
-            pieces,
-            "{model}: the same pieces"
-        );
+        strips_at_four_feet(model, &path, &tmp.path().join(format!("{model}.out")));
     }
+}
+
+/// Builds `model` at 4 ft within 0.5 % from the command line (every sheet checked) and
+/// checks its strips through the library: more than one, within the bound both ways,
+/// the pieces the command line made.
+fn strips_at_four_feet(what: &str, model: &Path, out: &Path) {
+    let m = strip_build(model, "4ft", "0.5%", &out.join("cli"));
+    let job = strip_job(model, "4ft", "0.5%", &out.join("job"));
+    let (strips, pieces) = check_strips(what, &job, num(&m, "strip.max_deviation"));
+    assert!(strips > 1, "{what}: {strips} strips");
+    assert_eq!(count(&m, "strip.pieces"), pieces, "{what}: the same pieces");
 }
 
 #[test]
@@ -495,12 +493,11 @@ fn a_model_with_legs_is_strips_within_the_bound() {
         return;
     };
     let tmp = TempDir::new().unwrap();
-    let horse = shared.join("horse_quad.obj");
-    let m = strip_build(&horse, "4ft", "0.5%", &tmp.path().join("out"));
-    let job = strip_job(&horse, "4ft", "0.5%", &tmp.path().join("job"));
-    let (strips, pieces) = check_strips("horse", &job, num(&m, "strip.max_deviation"));
-    assert!(strips > 1, "{strips} strips");
-    assert_eq!(count(&m, "strip.pieces"), pieces);
+    strips_at_four_feet(
+        "horse",
+        &shared.join("horse_quad.obj"),
+        &tmp.path().join("out"),
+    );
 }
 
 #[test]
