@@ -403,22 +403,36 @@ fn covering(
     sector_length: f64,
     ridged: bool,
 ) -> Result<Covering, SchemeError> {
-    let within = |sector_length: f64| {
-        strips_ridged(surface, field, tolerance, sector_length, ridged).map_err(|e| {
+    let within = |sector_length: f64, runs_back: RunsBack| {
+        strips_ridged(surface, field, tolerance, sector_length, ridged, runs_back).map_err(|e| {
             let fix = covering_fix(surface, &e);
             SchemeError::Model(format!(
                 "no strips within {tolerance:.3} mm of the model: {e}; {fix}"
             ))
         })
     };
-    let mut banded = within(sector_length)?;
+    let mut banded = within(sector_length, RunsBack::Welded)?;
     let mut welded = Welded::new(&banded.strips);
     // Each band's sectors were checked to join as they were cut; where strips of
-    // neighbouring bands still overlap, every band is kept whole instead.
-    let whole_bands = welded.is_err() && sector_length.is_finite();
-    if whole_bands {
-        banded = within(f64::INFINITY)?;
-        welded = Welded::new(&banded.strips);
+    // neighbouring bands still overlap, every band is kept whole instead, and where
+    // they still do not join, a strip that runs back over itself is split as it is
+    // made. The first failure is the one told.
+    let mut whole_bands = false;
+    let tries = [
+        (f64::INFINITY, RunsBack::Welded),
+        (sector_length, RunsBack::Made),
+    ];
+    for (length, runs_back) in tries {
+        if welded.is_ok() || (length, runs_back) == (sector_length, RunsBack::Welded) {
+            continue;
+        }
+        let Ok(again) = within(length, runs_back) else {
+            continue;
+        };
+        if let Ok(joined) = Welded::new(&again.strips) {
+            whole_bands = length > sector_length;
+            (banded, welded) = (again, Ok(joined));
+        }
     }
     Ok(Covering {
         welded: welded.map_err(SchemeError::Model)?,
@@ -504,7 +518,25 @@ fn within_unsimplified(
             other => other,
         })
     };
-    let first = cover(bound)?;
+    // Refined against what the samples find, the bound comes close to it.
+    let simplification = || {
+        beyond(
+            simplified,
+            unsimplified,
+            1.05 * sampled(simplified, unsimplified),
+        )
+    };
+    // Where no strips cover the simplified mesh, a simplification that strays too far
+    // is the cause to name first.
+    let first = match cover(bound) {
+        Err(SchemeError::Model(why)) => {
+            // A strip that folds round a coarse corner folds at any bound.
+            let strays = why.contains(STAYS_OFF);
+            let refusal = too_simplified(bound, simplification(), strays);
+            return Err(refusal.unwrap_or(SchemeError::Model(why)));
+        }
+        other => other?,
+    };
     let measured = to_model(&first);
     if measured <= bound {
         return Ok((first, measured));
@@ -537,12 +569,7 @@ fn within_unsimplified(
         tolerance = narrower;
         last_try = Some((covered, measured));
     }
-    // Refined against what the samples find, the bound comes close to it.
-    let simplification = beyond(
-        simplified,
-        unsimplified,
-        1.05 * sampled(simplified, unsimplified),
-    );
+    let simplification = simplification();
     let assured = bound - simplification;
     // Strips within `assured` of the simplified mesh keep the bound to the model as
     // given (the triangle inequality), even where the measured bound, which adds the
@@ -557,15 +584,34 @@ fn within_unsimplified(
         }
         _ => {}
     }
-    if assured < LEAST_SHARE * bound {
-        return Err(SchemeError::Options(format!(
-            "the simplified model lies up to {simplification:.2} mm from the model as given, which leaves the strips too little of --max-deviation ({bound:.2} mm): simplify less (more --target-edges or --target-faces, or none) or allow at least {:.2} mm",
-            simplification / (1.0 - LEAST_SHARE)
-        )));
+    if let Some(refusal) = too_simplified(bound, simplification, true) {
+        return Err(refusal);
     }
     let last = narrowed(assured)?;
     let measured = to_model(&last);
     Ok(kept(last, measured))
+}
+
+/// The refusal of a simplification that lies `simplification` from the model as given,
+/// where that leaves the strips less than [`LEAST_SHARE`] of `bound`; with the bound
+/// that would leave them enough where `larger_bound_helps`.
+fn too_simplified(
+    bound: f64,
+    simplification: f64,
+    larger_bound_helps: bool,
+) -> Option<SchemeError> {
+    let larger = match larger_bound_helps {
+        true => format!(
+            " or allow at least {:.2} mm",
+            simplification / (1.0 - LEAST_SHARE)
+        ),
+        false => String::new(),
+    };
+    (bound - simplification < LEAST_SHARE * bound).then(|| {
+        SchemeError::Options(format!(
+            "the simplified model lies up to {simplification:.2} mm from the model as given, which leaves the strips too little of --max-deviation ({bound:.2} mm): simplify less (more --target-edges or --target-faces, or none){larger}"
+        ))
+    })
 }
 
 /// The pieces: islands grown along the strips' rungs, in order, each strip longer than
@@ -2063,7 +2109,14 @@ pub fn strips_within(
     sector_length: f64,
 ) -> Result<Banded, String> {
     let ridged = ridged(surface, Closed::Harmonic);
-    strips_ridged(surface, field, tolerance, sector_length, ridged)
+    strips_ridged(
+        surface,
+        field,
+        tolerance,
+        sector_length,
+        ridged,
+        RunsBack::Welded,
+    )
 }
 
 /// [`strips_within`], where the field has ridges (a distance's, [`field_of`]) or not.
@@ -2073,6 +2126,7 @@ fn strips_ridged(
     tolerance: f64,
     sector_length: f64,
     ridged: bool,
+    runs_back: RunsBack,
 ) -> Result<Banded, String> {
     let (lo, hi) = field
         .iter()
@@ -2091,6 +2145,7 @@ fn strips_ridged(
         spacing,
         sector_length,
         span,
+        runs_back,
     };
     let whole = Patch {
         surface: surface.clone(),
@@ -2120,6 +2175,19 @@ struct Cover {
     sector_length: f64,
     /// The field's span over the whole surface.
     span: f64,
+    /// Where a strip that may fold runs back over its own triangles, it is found out.
+    runs_back: RunsBack,
+}
+
+/// Where a strip allowed to fold (round a saddle or a ridge) running back over its own
+/// triangles is found out: such a strip cannot be welded to its neighbours.
+#[derive(Clone, Copy, PartialEq)]
+enum RunsBack {
+    /// When its band's strips are welded: a band cut into sectors is then cut into
+    /// longer ones, which mends more of them than splitting them narrower does.
+    Welded,
+    /// When it is made: its part of the surface is split as if it strayed.
+    Made,
 }
 
 /// A connected part of the surface between two values of the field, covered by
@@ -2292,6 +2360,15 @@ impl Cover {
         if strip.triangles.is_empty() {
             return Err(format!(
                 "a region between levels {} and {} is too small for a triangle",
+                region.band,
+                region.band + 1
+            ));
+        }
+        // Allowed to fold, a strip may still not run back over its own triangles
+        // (round a bridge between two loops): it could not be welded to its neighbours.
+        if folds && self.runs_back == RunsBack::Made && runs_back(&strip) {
+            return Err(format!(
+                "the strip of a region between levels {} and {} runs back over itself",
                 region.band,
                 region.band + 1
             ));
@@ -2813,6 +2890,27 @@ fn points_inside<'a>(
     }
     found.sort_by(|x, y| x.0.total_cmp(&y.0));
     found.into_iter().map(|f| f.1).collect()
+}
+
+/// Whether an edge of `strip` (its corners taken by position, as the strips are
+/// welded) is a side of more than two of its triangles that cover something.
+fn runs_back(strip: &Strip) -> bool {
+    let mut id: HashMap<[u64; 3], u32> = HashMap::new();
+    let welded: Vec<u32> = strip
+        .points
+        .iter()
+        .map(|p| {
+            let next = id.len() as u32;
+            *id.entry(p.to_array().map(f64::to_bits)).or_insert(next)
+        })
+        .collect();
+    let covering: Vec<[u32; 3]> = strip
+        .triangles
+        .iter()
+        .filter(|t| has_area(t.map(|i| strip.points[i as usize])))
+        .map(|t| t.map(|i| welded[i as usize]))
+        .collect();
+    edge_uses(&covering).values().any(|&n| n > 2)
 }
 
 /// How many of `triangles` use each edge (by its corners, lower first).
@@ -3667,14 +3765,16 @@ mod tests {
         }
     }
 
+    /// Two parallel lines 20 apart in the plane z = 0, of 5 and 8 points.
+    fn two_lines() -> (Vec<DVec3>, Vec<DVec3>) {
+        let p = (0..5).map(|i| DVec3::new(i as f64 * 10.0, 0.0, 0.0));
+        let q = (0..8).map(|i| DVec3::new(i as f64 * 6.0, 20.0, 0.0));
+        (p.collect(), q.collect())
+    }
+
     #[test]
     fn a_band_between_straight_lines_in_a_plane_does_not_bend() {
-        let p: Vec<DVec3> = (0..5)
-            .map(|i| DVec3::new(i as f64 * 10.0, 0.0, 0.0))
-            .collect();
-        let q: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new(i as f64 * 6.0, 20.0, 0.0))
-            .collect();
+        let (p, q) = two_lines();
         let strip = band(&p, &q);
         assert_eq!(strip.triangles.len(), p.len() + q.len() - 2);
         for t in &strip.triangles {
@@ -3682,6 +3782,26 @@ mod tests {
             let normal = (b - a).cross(c - a);
             assert!(normal.z > 0.0, "counter-clockwise: {normal}");
         }
+    }
+
+    #[test]
+    fn a_strip_that_comes_back_over_a_triangle_runs_back_and_a_band_does_not() {
+        let (p, q) = two_lines();
+        let strip = band(&p, &q);
+        assert!(!runs_back(&strip));
+        // Back over its first triangle, through a second point at the same place as
+        // one of its corners (as a bridge between two loops is walked both ways).
+        let mut back = strip.clone();
+        let [a, b, c] = back.triangles[0];
+        back.points.push(back.points[a as usize]);
+        let again = back.points.len() as u32 - 1;
+        back.triangles.push([again, c, b]);
+        assert!(runs_back(&back));
+        // A triangle with no area (its corners welded) is not counted.
+        let mut flat = strip.clone();
+        flat.points.push(flat.points[a as usize]);
+        flat.triangles.push([a, flat.points.len() as u32 - 1, b]);
+        assert!(!runs_back(&flat));
     }
 
     /// A sphere of `radius` from a `around` × `rings` grid of latitudes, a point at
