@@ -16,6 +16,7 @@ use tempfile::TempDir;
 
 use common::build::*;
 use unfold::mesh::{FaceId, Mesh};
+use unfold::scheme::net::MATCH;
 
 /// An OBJ of `points` and `faces` (0-based), written to `dir/name.obj`.
 fn write_model(dir: &Path, name: &str, points: &[DVec3], faces: &[Vec<u32>]) -> PathBuf {
@@ -211,6 +212,7 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
             "{what}: S{strip} is not one run of faces"
         );
     }
+    check_seam_numbers(what, &p, surface);
     // Welded along shared curves: closed where the model is.
     assert_eq!(
         surface.boundary_loops().is_empty(),
@@ -243,6 +245,94 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
         "{what}: model {back} mm from the strips"
     );
     (strips.len(), p.panels.len())
+}
+
+/// One match number for each seam between two pieces (a run of cut edges end to end
+/// between the same two pieces, found here from the pieces' faces), numbered from 1,
+/// on two labels on the seam's two pieces; fewer numbers than cut edges.
+fn check_seam_numbers(what: &str, p: &Pipeline, surface: &Mesh) {
+    let mut piece_of = vec![usize::MAX; surface.face_count()];
+    for (k, group) in p.output.face_groups.iter().enumerate() {
+        for &f in &group.faces {
+            piece_of[f as usize] = k;
+        }
+    }
+    // Cut edges joined at a vertex where they lie between the same two pieces.
+    let mut seam: Vec<usize> = Vec::new();
+    let mut pieces_of_seam: Vec<(usize, usize)> = Vec::new();
+    let mut at: HashMap<(u32, (usize, usize)), usize> = HashMap::new();
+    for e in surface.edges() {
+        let h = e.half_edge();
+        let (Some(f), Some(g)) = (surface.face(h), surface.face(h.twin())) else {
+            continue;
+        };
+        let (a, b) = (piece_of[f.index()], piece_of[g.index()]);
+        if a == b {
+            continue;
+        }
+        let pair = (a.min(b), a.max(b));
+        let root = |seam: &Vec<usize>, mut k: usize| {
+            while seam[k] != k {
+                k = seam[k];
+            }
+            k
+        };
+        let k = seam.len();
+        seam.push(k);
+        pieces_of_seam.push(pair);
+        for v in [surface.origin(h), surface.dest(h)] {
+            match at.get(&(v.0, pair)) {
+                Some(&other) => {
+                    let (r, s) = (root(&seam, other), root(&seam, k));
+                    seam[r.max(s)] = r.min(s);
+                }
+                None => {
+                    at.insert((v.0, pair), k);
+                }
+            }
+        }
+    }
+    let seams = (0..seam.len()).filter(|&k| seam[k] == k).count();
+    let mut labels: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
+    let mut dropped = 0;
+    for (k, panel) in p.panels.iter().enumerate() {
+        for label in panel.labels.iter().filter(|l| l.text.kind == &MATCH) {
+            labels.entry(label.text.number).or_default().push(k);
+        }
+        dropped += panel.labels_dropped.partner;
+    }
+    // Numbers 1 to n, two labels each: the labels kept and those with no room.
+    let numbers = labels.keys().last().copied().unwrap_or(0) as usize;
+    let kept: usize = labels.values().map(Vec::len).sum();
+    assert_eq!(kept + dropped, 2 * numbers, "{what}: two labels per number");
+    // A number on one piece twice is a seam of a piece with itself (where a ring is
+    // cut open), which the pieces' faces alone do not tell from a fold.
+    let pairs: BTreeSet<(usize, usize)> = pieces_of_seam.into_iter().collect();
+    let mut between = 0;
+    for (number, on) in &labels {
+        assert!(on.len() <= 2, "{what}: match number {number} on {on:?}");
+        let [a, b] = on[..] else {
+            continue;
+        };
+        if a != b {
+            between += 1;
+            assert!(
+                pairs.contains(&(a.min(b), a.max(b))),
+                "{what}: match number {number} on two pieces with no seam between them"
+            );
+        }
+    }
+    eprintln!("{what}: {numbers} match numbers, {seams} seams between pieces, {between} numbered on both, {dropped} labels with no room");
+    // At most one seam of a piece with itself: a ring cut open once.
+    assert!(
+        between <= seams && seams <= numbers && numbers <= seams + p.panels.len(),
+        "{what}: one match number per seam"
+    );
+    let cuts = p.output.connections;
+    assert!(
+        numbers <= cuts,
+        "{what}: {numbers} numbers for {cuts} cut edges"
+    );
 }
 
 /// The scheme's `strip` section of the manifest.

@@ -21,7 +21,7 @@
 //! lowered, and only where no height fits is it left out (and counted). Both sides of a
 //! cut carry the same match number.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 
 use glam::{DVec2, DVec3};
 
@@ -32,6 +32,7 @@ use super::rigid_sheet::{
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::coplanar::{flat_regions, RegionRules};
+use crate::mesh::soup::{find, union};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::surface::group_anchor;
@@ -1150,6 +1151,10 @@ pub struct OwnNet<'a> {
     /// True when the face of half-edge `h` is to own its edge's tab, rather than the
     /// face across (that side is tried first).
     pub tab_first: &'a dyn Fn(HalfedgeId) -> bool,
+    /// One match number for each seam (a run of cut edges end to end between the same
+    /// two islands), on both sides of its longest edge, rather than one at every cut
+    /// edge: along a strip's curve the edges are many and short.
+    pub seams: bool,
 }
 
 /// A net and what its report says of it.
@@ -1243,11 +1248,7 @@ fn island_net(
         mesh,
         islands: &islands,
         tabs: &tabs,
-        match_of: cuts
-            .iter()
-            .enumerate()
-            .map(|(k, e)| (e.0, k as u32 + 1))
-            .collect(),
+        match_of: match_numbers(mesh, &cuts, &number, names),
         facet_of,
         options,
     };
@@ -1367,13 +1368,71 @@ fn unfastened(
         .collect()
 }
 
+/// Each cut edge's match number, from 1 in the order of `cuts`: one for each cut, or
+/// where the scheme asks for seams, one for each seam, only at its longest edge (the
+/// first of equals). `number` is each face's island.
+fn match_numbers(
+    mesh: &Mesh,
+    cuts: &[EdgeId],
+    number: &[u32],
+    names: &IslandNames,
+) -> HashMap<u32, u32> {
+    if !matches!(names, IslandNames::Own(OwnNet { seams: true, .. })) {
+        return (cuts.iter().enumerate())
+            .map(|(k, e)| (e.0, k as u32 + 1))
+            .collect();
+    }
+    // The two islands a cut edge lies between, lower first.
+    let islands = |e: EdgeId| {
+        let h = e.half_edge();
+        let of = |h: HalfedgeId| mesh.face(h).map_or(0, |f| number[f.index()]);
+        let (a, b) = (of(h), of(h.twin()));
+        (a.min(b), a.max(b))
+    };
+    // Cut edges meeting at a vertex between the same two islands are one seam.
+    let mut parent: Vec<u32> = (0..cuts.len() as u32).collect();
+    let mut at_vertex: BTreeMap<(u32, (u32, u32)), u32> = BTreeMap::new();
+    for (k, &e) in cuts.iter().enumerate() {
+        let h = e.half_edge();
+        for v in [mesh.origin(h), mesh.dest(h)] {
+            match at_vertex.entry((v.0, islands(e))) {
+                std::collections::btree_map::Entry::Vacant(slot) => {
+                    slot.insert(k as u32);
+                }
+                std::collections::btree_map::Entry::Occupied(slot) => {
+                    union(&mut parent, *slot.get(), k as u32);
+                }
+            }
+        }
+    }
+    let length = |e: EdgeId| {
+        let h = e.half_edge();
+        mesh.position(mesh.origin(h))
+            .distance(mesh.position(mesh.dest(h)))
+    };
+    // Each seam's longest edge, seams in the order of their first edge.
+    let mut longest: BTreeMap<u32, (u32, usize)> = BTreeMap::new();
+    for (k, &e) in cuts.iter().enumerate() {
+        let seam = find(&mut parent, k as u32);
+        let first = longest.entry(seam).or_insert((k as u32, k));
+        if length(e) > length(cuts[first.1]) {
+            first.1 = k;
+        }
+    }
+    let mut firsts: Vec<(u32, usize)> = longest.into_values().collect();
+    firsts.sort_unstable();
+    (firsts.iter().enumerate())
+        .map(|(m, &(_, k))| (cuts[k].0, m as u32 + 1))
+        .collect()
+}
+
 /// What every island's panel is built from.
 struct BuiltNet<'a> {
     mesh: &'a Mesh,
     islands: &'a Islands,
     /// The tab of each cut edge, where one fits.
     tabs: &'a [Option<Tab>],
-    /// Each cut edge's match number (from 1).
+    /// Each cut edge's match number (from 1), where it carries one.
     match_of: HashMap<u32, u32>,
     /// Each face's facet in its island's panel.
     facet_of: Vec<u32>,
@@ -1468,8 +1527,11 @@ fn tab_facets(net: &BuiltNet, tab_bases: Vec<(EdgeId, u32, u32)>, parts: &mut Pa
         }
         parts.facets.push(facet);
         let (a, b) = (placed.base[0], placed.base[1]);
+        let Some(&m) = net.match_of.get(&e.0) else {
+            continue;
+        };
         parts.labels.push(Label {
-            text: Name::new(&MATCH, net.match_of[&e.0]),
+            text: Name::new(&MATCH, m),
             anchor: 0.5 * (a + b),
             direction: (a - b).normalize(),
             height: net.options.panel.label_height,

@@ -643,6 +643,7 @@ fn clear_pieces(
         let own = OwnNet {
             names: &names,
             tab_first,
+            seams: true,
         };
         let mut along = folds.clone();
         along.extend(joins.values().filter_map(|(edges, k)| edges.get(*k)));
