@@ -19,7 +19,8 @@
 //! tabs under one face never meet). Laid flat, a tab must keep clear of its island's
 //! other faces and tabs: where it does not, the other side is tried and the tab is
 //! lowered, and only where no height fits is it left out (and counted). Both sides of a
-//! cut carry the same match number.
+//! cut carry the same match number (or, where the scheme asks for seams, both sides of
+//! each seam's longest edge: a run of cut edges end to end between two islands).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -1450,7 +1451,7 @@ struct PanelParts {
 
 /// Builds island `number`'s panel: its faces (facets in face order, corners shared
 /// along folds), then the tabs its faces own; the island id on a central face, match
-/// numbers at every cut edge on both sides.
+/// numbers on both sides of every cut edge that carries one.
 fn island_panel(net: &BuiltNet, source: Source, faces: &[u32]) -> Panel {
     let mut parts = PanelParts::default();
     let tab_bases = island_faces(net, faces, &mut parts);
@@ -1527,19 +1528,18 @@ fn tab_facets(net: &BuiltNet, tab_bases: Vec<(EdgeId, u32, u32)>, parts: &mut Pa
         }
         parts.facets.push(facet);
         let (a, b) = (placed.base[0], placed.base[1]);
-        let Some(&m) = net.match_of.get(&e.0) else {
-            continue;
-        };
-        parts.labels.push(Label {
-            text: Name::new(&MATCH, m),
-            anchor: 0.5 * (a + b),
-            direction: (a - b).normalize(),
-            height: net.options.panel.label_height,
-            facet: facet_index,
-            kind: LabelKind::Partner,
-            on_edge: true,
-            slide: 0.2 * a.distance(b),
-        });
+        if let Some(&m) = net.match_of.get(&e.0) {
+            parts.labels.push(Label {
+                text: Name::new(&MATCH, m),
+                anchor: 0.5 * (a + b),
+                direction: (a - b).normalize(),
+                height: net.options.panel.label_height,
+                facet: facet_index,
+                kind: LabelKind::Partner,
+                on_edge: true,
+                slide: 0.2 * a.distance(b),
+            });
+        }
         parts.holes.extend(placed.holes.iter().map(|&p| Hole {
             position: p,
             diameter: net.options.panel.hole_diameter,

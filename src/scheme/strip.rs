@@ -286,11 +286,22 @@ fn strip_panels(
     // A harmonic field between two poles stays nearly level along a dead end (a
     // horse's legs), too flat to split into bands; the distance from one pole rises
     // along every branch. The first failure is the one told.
-    let (covered, measured) = match covered_with(Closed::Harmonic) {
+    let covered = match covered_with(Closed::Harmonic) {
         Err(SchemeError::Model(why)) if closed_part(&surface) => {
-            covered_with(Closed::Distance).map_err(|_| SchemeError::Model(why))?
+            covered_with(Closed::Distance).map_err(|_| SchemeError::Model(why))
         }
-        other => other?,
+        other => other,
+    };
+    // Where no strips cover a simplified mesh, a simplification that strays too far
+    // is the cause to name first; a larger bound only where a band strayed (a strip
+    // that folds round a coarse corner folds at any bound).
+    let (covered, measured) = match (covered, unsimplified) {
+        (Err(SchemeError::Model(why)), Some(given)) => {
+            let apart = simplification_distance(bound, &surface.soup(), given);
+            let refusal = too_simplified(bound, apart, why.contains(STAYS_OFF));
+            return Err(refusal.unwrap_or(SchemeError::Model(why)));
+        }
+        (other, _) => other?,
     };
     let Covering {
         banded,
@@ -486,13 +497,7 @@ fn within_unsimplified(
     unsimplified: &[[DVec3; 3]],
     cover: &dyn Fn(f64) -> Result<Covering, SchemeError>,
 ) -> Result<(Covering, f64), SchemeError> {
-    type Soup<'a> = &'a [[DVec3; 3]];
     let spacing = bound / 3.0;
-    // The larger of the two ways, each on its own thread.
-    let both_ways = |a: Soup, b: Soup, one_way: &(dyn Fn(Soup, Soup) -> f64 + Sync)| {
-        let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
-        out.max(back)
-    };
     // A bound that holds at every point, refined until settled against `within`.
     let beyond = |a: Soup, b: Soup, within: f64| {
         both_ways(a, b, &|from, to| {
@@ -518,25 +523,7 @@ fn within_unsimplified(
             other => other,
         })
     };
-    // Refined against what the samples find, the bound comes close to it.
-    let simplification = || {
-        beyond(
-            simplified,
-            unsimplified,
-            1.05 * sampled(simplified, unsimplified),
-        )
-    };
-    // Where no strips cover the simplified mesh, a simplification that strays too far
-    // is the cause to name first.
-    let first = match cover(bound) {
-        Err(SchemeError::Model(why)) => {
-            // A strip that folds round a coarse corner folds at any bound.
-            let strays = why.contains(STAYS_OFF);
-            let refusal = too_simplified(bound, simplification(), strays);
-            return Err(refusal.unwrap_or(SchemeError::Model(why)));
-        }
-        other => other?,
-    };
+    let first = cover(bound)?;
     let measured = to_model(&first);
     if measured <= bound {
         return Ok((first, measured));
@@ -569,7 +556,7 @@ fn within_unsimplified(
         tolerance = narrower;
         last_try = Some((covered, measured));
     }
-    let simplification = simplification();
+    let simplification = simplification_distance(bound, simplified, unsimplified);
     let assured = bound - simplification;
     // Strips within `assured` of the simplified mesh keep the bound to the model as
     // given (the triangle inequality), even where the measured bound, which adds the
@@ -590,6 +577,28 @@ fn within_unsimplified(
     let last = narrowed(assured)?;
     let measured = to_model(&last);
     Ok(kept(last, measured))
+}
+
+/// Triangles, by their corners.
+type Soup<'a> = &'a [[DVec3; 3]];
+
+/// The larger of `one_way` from `a` to `b` and from `b` to `a`, each on its own thread.
+fn both_ways(a: Soup, b: Soup, one_way: &(dyn Fn(Soup, Soup) -> f64 + Sync)) -> f64 {
+    let (out, back) = rayon::join(|| one_way(a, b), || one_way(b, a));
+    out.max(back)
+}
+
+/// How far `simplified` and `unsimplified` lie apart, both ways: a bound that holds at
+/// every point (samples a third of `bound` apart), refined against what samples a
+/// quarter as far apart find, so that it comes close to it.
+fn simplification_distance(bound: f64, simplified: Soup, unsimplified: Soup) -> f64 {
+    let spacing = bound / 3.0;
+    let sampled = both_ways(simplified, unsimplified, &|from, to| {
+        one_way_distance(from, to, spacing / 4.0)
+    });
+    both_ways(simplified, unsimplified, &|from, to| {
+        distance_beyond(from, to, spacing, 1.05 * sampled, f64::INFINITY)
+    })
 }
 
 /// The refusal of a simplification that lies `simplification` from the model as given,
