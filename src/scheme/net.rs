@@ -19,8 +19,9 @@
 //! tabs under one face never meet). Laid flat, a tab must keep clear of its island's
 //! other faces and tabs: where it does not, the other side is tried and the tab is
 //! lowered, and only where no height fits is it left out (and counted). Both sides of a
-//! cut carry the same match number (or, where the scheme asks for seams, both sides of
-//! each seam's longest edge: a run of cut edges end to end between two islands).
+//! cut carry the same match number (or, where the scheme asks for seams, the faces on
+//! both sides of one edge of each seam: a run of cut edges end to end between two
+//! islands).
 
 use std::collections::{BTreeMap, HashMap};
 
@@ -1153,8 +1154,9 @@ pub struct OwnNet<'a> {
     /// face across (that side is tried first).
     pub tab_first: &'a dyn Fn(HalfedgeId) -> bool,
     /// One match number for each seam (a run of cut edges end to end between the same
-    /// two islands), on both sides of its longest edge, rather than one at every cut
-    /// edge: along a strip's curve the edges are many and short.
+    /// two islands), inside the faces on both sides of the edge with the most room
+    /// beside it, rather than one at every cut edge: along a strip's curve the edges
+    /// are many and short.
     pub seams: bool,
 }
 
@@ -1250,6 +1252,7 @@ fn island_net(
         islands: &islands,
         tabs: &tabs,
         match_of: match_numbers(mesh, &cuts, &number, names),
+        seams: matches!(names, IslandNames::Own(OwnNet { seams: true, .. })),
         facet_of,
         options,
     };
@@ -1369,9 +1372,12 @@ fn unfastened(
         .collect()
 }
 
+/// A match number's width per unit of its height, about (three digits).
+const NUMBER_WIDTH: f64 = 2.5;
+
 /// Each cut edge's match number, from 1 in the order of `cuts`: one for each cut, or
-/// where the scheme asks for seams, one for each seam, only at its longest edge (the
-/// first of equals). `number` is each face's island.
+/// where the scheme asks for seams, one for each seam, only at the edge with the most
+/// room beside it (the first of equals). `number` is each face's island.
 fn match_numbers(
     mesh: &Mesh,
     cuts: &[EdgeId],
@@ -1406,21 +1412,29 @@ fn match_numbers(
             }
         }
     }
-    let length = |e: EdgeId| {
+    // The largest number an edge has room for beside it, about: its length over a
+    // number's width per unit of height, or the height of the faces over it.
+    let room = |e: EdgeId| {
         let h = e.half_edge();
-        mesh.position(mesh.origin(h))
-            .distance(mesh.position(mesh.dest(h)))
+        let length = mesh
+            .position(mesh.origin(h))
+            .distance(mesh.position(mesh.dest(h)));
+        let height = |h: HalfedgeId| {
+            mesh.face(h)
+                .map_or(0.0, |f| 2.0 * mesh.face_area(f) / length)
+        };
+        (length / NUMBER_WIDTH).min(height(h)).min(height(h.twin()))
     };
-    // Each seam's longest edge, seams in the order of their first edge.
-    let mut longest: BTreeMap<u32, (u32, usize)> = BTreeMap::new();
+    // Each seam's roomiest edge, seams in the order of their first edge.
+    let mut roomiest: BTreeMap<u32, (u32, usize)> = BTreeMap::new();
     for (k, &e) in cuts.iter().enumerate() {
         let seam = find(&mut parent, k as u32);
-        let first = longest.entry(seam).or_insert((k as u32, k));
-        if length(e) > length(cuts[first.1]) {
+        let first = roomiest.entry(seam).or_insert((k as u32, k));
+        if room(e) > room(cuts[first.1]) {
             first.1 = k;
         }
     }
-    let mut firsts: Vec<(u32, usize)> = longest.into_values().collect();
+    let mut firsts: Vec<(u32, usize)> = roomiest.into_values().collect();
     firsts.sort_unstable();
     (firsts.iter().enumerate())
         .map(|(m, &(_, k))| (cuts[k].0, m as u32 + 1))
@@ -1435,6 +1449,8 @@ struct BuiltNet<'a> {
     tabs: &'a [Option<Tab>],
     /// Each cut edge's match number (from 1), where it carries one.
     match_of: HashMap<u32, u32>,
+    /// Numbered once per seam ([`OwnNet::seams`]).
+    seams: bool,
     /// Each face's facet in its island's panel.
     facet_of: Vec<u32>,
     options: &'a NetOptions,
@@ -1494,7 +1510,10 @@ fn island_faces(net: &BuiltNet, faces: &[u32], parts: &mut PanelParts) -> Vec<(E
                 tab_bases.push((e, n - 2, n - 1));
             }
             // The match number inside this face at a cut edge, unless its tab carries it.
-            if let (Some(&m), None) = (net.match_of.get(&e.0), own_tab) {
+            // Numbered once per seam, the number goes inside the face on both sides,
+            // where there is more room than on a tab.
+            let inside = own_tab.is_none() || net.seams;
+            if let (Some(&m), true) = (net.match_of.get(&e.0), inside) {
                 let (a, b) = (mesh.position(mesh.origin(h)), mesh.position(mesh.dest(h)));
                 parts.labels.push(Label {
                     text: Name::new(&MATCH, m),
@@ -1528,7 +1547,7 @@ fn tab_facets(net: &BuiltNet, tab_bases: Vec<(EdgeId, u32, u32)>, parts: &mut Pa
         }
         parts.facets.push(facet);
         let (a, b) = (placed.base[0], placed.base[1]);
-        if let Some(&m) = net.match_of.get(&e.0) {
+        if let (Some(&m), true) = (net.match_of.get(&e.0), !net.seams) {
             parts.labels.push(Label {
                 text: Name::new(&MATCH, m),
                 anchor: 0.5 * (a + b),
