@@ -842,7 +842,9 @@ fn a_simplified_model_keeps_the_bound_to_the_model_as_given() {
 /// A band whose strip folds over its outline however narrow it is split (round the
 /// sharp corners of a coarse model, or round holes) is not a matter of the bound: the
 /// refusal says a larger --max-deviation does not change it and names what builds,
-/// closing the holes where the model has any, and the net scheme.
+/// closing the holes where the model has any, and the net scheme. Where the
+/// simplification itself leaves the strips too little of the bound, that is named
+/// first, without a larger bound.
 #[test]
 fn strips_that_fold_at_any_bound_name_what_builds() {
     let Some(shared) = shared_models("strips_that_fold_at_any_bound_name_what_builds") else {

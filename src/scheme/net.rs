@@ -1247,12 +1247,13 @@ fn island_net(
             facet_of[f as usize] = i as u32;
         }
     }
+    let seams = matches!(names, IslandNames::Own(OwnNet { seams: true, .. }));
     let net = BuiltNet {
         mesh,
         islands: &islands,
         tabs: &tabs,
-        match_of: match_numbers(mesh, &cuts, &number, names),
-        seams: matches!(names, IslandNames::Own(OwnNet { seams: true, .. })),
+        match_of: match_numbers(mesh, &cuts, &number, seams),
+        seams,
         facet_of,
         options,
     };
@@ -1376,15 +1377,10 @@ fn unfastened(
 const NUMBER_WIDTH: f64 = 2.5;
 
 /// Each cut edge's match number, from 1 in the order of `cuts`: one for each cut, or
-/// where the scheme asks for seams, one for each seam, only at the edge with the most
-/// room beside it (the first of equals). `number` is each face's island.
-fn match_numbers(
-    mesh: &Mesh,
-    cuts: &[EdgeId],
-    number: &[u32],
-    names: &IslandNames,
-) -> HashMap<u32, u32> {
-    if !matches!(names, IslandNames::Own(OwnNet { seams: true, .. })) {
+/// with `seams`, one for each seam, only at the edge with the most room beside it (the
+/// first of equals). `number` is each face's island.
+fn match_numbers(mesh: &Mesh, cuts: &[EdgeId], number: &[u32], seams: bool) -> HashMap<u32, u32> {
+    if !seams {
         return (cuts.iter().enumerate())
             .map(|(k, e)| (e.0, k as u32 + 1))
             .collect();

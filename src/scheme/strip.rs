@@ -429,13 +429,14 @@ fn covering(
     // they still do not join, a strip that runs back over itself is split as it is
     // made. The first failure is the one told.
     let mut whole_bands = false;
-    let tries = [
-        (f64::INFINITY, RunsBack::Welded),
-        (sector_length, RunsBack::Made),
-    ];
+    let mut tries = Vec::new();
+    if sector_length.is_finite() {
+        tries.push((f64::INFINITY, RunsBack::Welded));
+    }
+    tries.push((sector_length, RunsBack::Made));
     for (length, runs_back) in tries {
-        if welded.is_ok() || (length, runs_back) == (sector_length, RunsBack::Welded) {
-            continue;
+        if welded.is_ok() {
+            break;
         }
         let Ok(again) = within(length, runs_back) else {
             continue;
