@@ -25,9 +25,9 @@
 //!
 //! Why: every edge becomes a panel, and panels of one size nest tighter and hold
 //! fastener holes more evenly. On the bunny at 625 edges (quad-edge, 4 ft) the edge
-//! at the 95th percentile goes from 1.64 to 1.42 times the median, for about 0.25 s;
-//! at 1000 edges the flips alone take the face corners without room for a 1/8 in
-//! fastener from 11 to 6 on horse_quad and from 4 to none on fertility.
+//! at the 95th percentile goes from 1.64 to 1.42 times the median; at 1000 edges the
+//! flips alone take the face corners without room for a 1/8 in fastener from 11 to 6
+//! on horse_quad and from 4 to none on fertility.
 
 use std::collections::HashMap;
 

@@ -8,10 +8,10 @@
 //! The separation's cost is in evaluating overlap: collecting every collision of a
 //! pose, where the constructive search stops at the first, and weighing the disc
 //! pairs. The effort budget counts each evaluation as [`OVERLAP_CHECK_COST`] checks
-//! plus one per [`DISC_PAIRS_PER_CHECK`] disc pairs, fitted to the times measured on
-//! the bunny and the knight (an evaluation took about 2 µs plus 2 ns per disc pair,
-//! against 0.3 µs for a constructive check). On sheets holding hundreds of parts
-//! (horse_quad quad-edge) an evaluation takes about twice what it counts.
+//! plus one per [`DISC_PAIRS_PER_CHECK`] disc pairs: the cost of an evaluation relative
+//! to a constructive check, as measured on the bunny and the knight. On sheets holding
+//! hundreds of parts (horse_quad quad-edge) an evaluation costs about twice what it
+//! counts.
 //!
 //! Overlap between two parts is measured on discs inside their collision shapes (the
 //! engine's poles and a lattice of inscribed discs), as sparrow does: for every pair of
