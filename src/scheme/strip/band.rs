@@ -354,8 +354,8 @@ fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scheme::strip::conform::outline_of;
     use crate::scheme::strip::distance::one_way_distance;
-    use crate::scheme::strip::outline_of;
     use crate::scheme::strip::test_shapes::{tube, two_lines};
 
     #[test]

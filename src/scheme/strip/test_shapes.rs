@@ -8,8 +8,8 @@ use std::f64::consts::TAU;
 use glam::DVec3;
 
 use super::band::{strip_soup, unroll};
+use super::conform::outline_of;
 use super::distance::one_way_distance;
-use super::outline_of;
 use super::strips_within;
 use super::surface::{cycle_pairs, rims, Triangles};
 
