@@ -240,7 +240,7 @@ fn split_outline_edge(strip: &mut Strip, a: u32, b: u32, inside: &[DVec3]) {
 mod tests {
     use super::*;
     use crate::scheme::strip::band::band;
-    use crate::scheme::strip::strips_within;
+    use crate::scheme::strip::cover::strips_within;
     use crate::scheme::strip::test_shapes::{check_strips_cut, heights, tube, two_lines};
 
     #[test]

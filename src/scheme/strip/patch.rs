@@ -16,7 +16,7 @@ pub(super) struct Patch {
     pub(super) ends: [f64; 2],
 }
 
-/// How [`strips_within`](super::strips_within) covers the surface.
+/// How [`strips_within`](super::cover::strips_within) covers the surface.
 #[derive(Clone, Copy)]
 pub(super) struct Cover {
     /// The field is a distance from rims, its saddles ridges

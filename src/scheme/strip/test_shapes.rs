@@ -9,8 +9,8 @@ use glam::DVec3;
 
 use super::band::{strip_soup, unroll};
 use super::conform::outline_of;
+use super::cover::strips_within;
 use super::distance::one_way_distance;
-use super::strips_within;
 use super::surface::{cycle_pairs, rims, Triangles};
 
 /// A tube of `around` × `along` quads split into triangles, radius `r(h)` at
