@@ -31,6 +31,7 @@ pub mod rng;
 pub mod run;
 pub mod sanity;
 pub mod scheme;
+pub mod union_find;
 pub mod units;
 
 pub use config::{BuildOptions, Job, ModelOptions, ModelSettings, NonPlanar};

@@ -8,6 +8,7 @@
 
 use super::build::{build_mesh, BuildError};
 use super::{Mesh, Polygons};
+use crate::union_find::UnionFind;
 use glam::DVec3;
 
 /// What [`fill_holes`] closed.
@@ -36,7 +37,7 @@ pub fn fill_holes(mesh: &Mesh) -> Result<Option<(Mesh, FilledHoles)>, BuildError
     }
     let mut filled = FilledHoles::default();
     let mut caps = Vec::new();
-    let mut joined_to: Vec<u32> = (0..mesh.vertex_count() as u32).collect();
+    let mut joined_to = UnionFind::new(mesh.vertex_count());
     for &start in &loops {
         // A boundary half-edge runs the way the missing face would wind.
         let corners: Vec<u32> = mesh.loop_from(start).map(|h| mesh.origin(h).0).collect();
@@ -64,17 +65,9 @@ pub fn fill_holes(mesh: &Mesh) -> Result<Option<(Mesh, FilledHoles)>, BuildError
             .iter()
             .map(|&start| mesh.loop_from(start).map(|h| mesh.origin(h).0).collect())
             .collect();
-        joined_to = (0..mesh.vertex_count() as u32).collect();
+        joined_to = UnionFind::new(mesh.vertex_count());
     }
     Ok(Some((closed_with(mesh, &caps, &joined_to)?, filled)))
-}
-
-/// The vertex `v` has been joined to (itself when none).
-fn root(joined_to: &[u32], mut v: u32) -> u32 {
-    while joined_to[v as usize] != v {
-        v = joined_to[v as usize];
-    }
-    v
 }
 
 /// Closes the loop `corners`, pushing its caps. Where the rim runs out to a corner and
@@ -85,7 +78,7 @@ fn root(joined_to: &[u32], mut v: u32) -> u32 {
 fn close_loop(
     corners: Vec<u32>,
     positions: &[DVec3],
-    joined_to: &mut [u32],
+    joined_to: &mut UnionFind,
     joined: &mut bool,
     caps: &mut Vec<Vec<u32>>,
 ) {
@@ -95,11 +88,8 @@ fn close_loop(
         return;
     }
     let at = |i: usize| positions[corners[i % n] as usize];
-    let mut join = |later: u32, earlier: u32, joined_to: &mut [u32]| {
-        let (later, earlier) = (root(joined_to, later), root(joined_to, earlier));
-        if later != earlier {
-            joined_to[later as usize] = earlier;
-        }
+    let mut join = |later: u32, earlier: u32, joined_to: &mut UnionFind| {
+        joined_to.join_onto(later, earlier);
         *joined = true;
     };
     if n > 3 {
@@ -131,7 +121,7 @@ fn close_loop(
 
 /// `mesh`'s faces and the `caps`, each vertex replaced by the one it was joined to
 /// and vertices no face uses left out.
-fn closed_with(mesh: &Mesh, caps: &[Vec<u32>], joined_to: &[u32]) -> Result<Mesh, BuildError> {
+fn closed_with(mesh: &Mesh, caps: &[Vec<u32>], joined_to: &UnionFind) -> Result<Mesh, BuildError> {
     let mut polys = Polygons::new();
     polys.positions = mesh.positions().to_vec();
     let faces = mesh
@@ -139,7 +129,7 @@ fn closed_with(mesh: &Mesh, caps: &[Vec<u32>], joined_to: &[u32]) -> Result<Mesh
         .map(|f| mesh.face_vertices(f).map(|v| v.0).collect::<Vec<u32>>())
         .chain(caps.iter().cloned());
     for corners in faces {
-        let joined: Vec<u32> = corners.into_iter().map(|v| root(joined_to, v)).collect();
+        let joined: Vec<u32> = corners.into_iter().map(|v| joined_to.root(v)).collect();
         polys.push_face(&joined);
     }
     let sources: Vec<u32> = mesh.vertices().map(|v| mesh.vertex_source(v)).collect();

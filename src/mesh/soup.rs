@@ -4,6 +4,7 @@
 use rayon::slice::ParallelSliceMut;
 
 use super::polygons::Polygons;
+use crate::union_find::UnionFind;
 
 /// Face corners grouped by undirected edge. Corner `c` is the corner at `indices[c]`;
 /// its edge runs to the next corner of the same face.
@@ -70,7 +71,7 @@ pub(crate) fn corner_edge(polys: &Polygons, corner_face: &[u32], c: u32) -> (u32
 /// faces sharing edges at that vertex joins them. Returns, per corner, the smallest
 /// corner index of its fan. Works whatever the orientation of the faces.
 pub(crate) fn corner_fans(polys: &Polygons, edges: &CornerEdges) -> Vec<u32> {
-    let mut parent: Vec<u32> = (0..polys.indices.len() as u32).collect();
+    let mut fans = UnionFind::new(polys.indices.len());
     for group in edges.groups() {
         let Some(&(_, first)) = group.first() else {
             continue;
@@ -80,13 +81,11 @@ pub(crate) fn corner_fans(polys: &Polygons, edges: &CornerEdges) -> Vec<u32> {
             for end in [0, 1] {
                 let a = corner_at_end(polys, &edges.corner_face, first, end);
                 let b = corner_at(polys, &edges.corner_face, other, polys.indices[a as usize]);
-                union(&mut parent, a, b);
+                fans.union(a, b);
             }
         }
     }
-    (0..parent.len() as u32)
-        .map(|c| find(&mut parent, c))
-        .collect()
+    fans.roots()
 }
 
 /// The number of fans at every vertex: 0 for a vertex no face uses, 1 for a manifold
@@ -123,24 +122,6 @@ fn corner_at(polys: &Polygons, corner_face: &[u32], c: u32, v: u32) -> u32 {
         c
     } else {
         next_corner(polys, corner_face, c)
-    }
-}
-
-pub(crate) fn find(parent: &mut [u32], mut x: u32) -> u32 {
-    while parent[x as usize] != x {
-        let grand = parent[parent[x as usize] as usize];
-        parent[x as usize] = grand;
-        x = grand;
-    }
-    x
-}
-
-/// Joins two sets; the smaller root wins, so roots do not depend on union order.
-pub(crate) fn union(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    if ra != rb {
-        let (lo, hi) = if ra < rb { (ra, rb) } else { (rb, ra) };
-        parent[hi as usize] = lo;
     }
 }
 

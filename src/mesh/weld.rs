@@ -10,6 +10,7 @@ use rayon::slice::ParallelSliceMut;
 
 use super::polygons::Polygons;
 use super::soup::{fan_counts, CornerEdges};
+use crate::union_find::UnionFind;
 
 /// The welding tolerance for a set of points: a ten-millionth of the bounding-box
 /// diagonal. Single-precision files repeat a shared vertex bit for bit, and double
@@ -32,10 +33,10 @@ pub fn weld_tolerance(points: &[DVec3]) -> f64 {
 /// cell; a point looks into a neighbouring cell only along the axes where it lies
 /// within the tolerance of its cell's border, so almost every point searches one cell.
 pub fn cluster_positions(points: &[DVec3], tolerance: f64) -> Vec<u32> {
-    let mut parent: Vec<u32> = (0..points.len() as u32).collect();
     if points.is_empty() {
-        return parent;
+        return Vec::new();
     }
+    let mut clusters = UnionFind::new(points.len());
     let (lo, hi) = super::geometry::bounding_box(points.iter().copied());
     let diagonal = (hi - lo).length();
     if diagonal.is_nan() || diagonal <= 0.0 {
@@ -102,16 +103,14 @@ pub fn cluster_positions(points: &[DVec3], tolerance: f64) -> Vec<u32> {
                             break;
                         }
                         if (j as usize) < i && close(points[j as usize], p) {
-                            super::soup::union(&mut parent, i as u32, j);
+                            clusters.union(i as u32, j);
                         }
                     }
                 }
             }
         }
     }
-    (0..points.len() as u32)
-        .map(|i| super::soup::find(&mut parent, i))
-        .collect()
+    clusters.roots()
 }
 
 /// What a manifold-aware weld did.

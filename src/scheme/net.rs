@@ -34,7 +34,6 @@ use super::rigid_sheet::{
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::coplanar::{flat_regions, RegionRules};
-use crate::mesh::soup::{find, union};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::panel::surface::group_anchor;
@@ -43,6 +42,7 @@ use crate::panel::{
 };
 use crate::plane::{convex_hull, fits_rotated};
 use crate::record::{round4, Params};
+use crate::union_find::UnionFind;
 use crate::units::fmt_path_length;
 
 /// The default `--island-spread`: islands whose convex hull is at most one and a half
@@ -343,38 +343,6 @@ const TOUCH: f64 = 1e-6;
 /// outline never touches itself there.
 const NOTCH_GAP: f64 = 0.05;
 
-/// Union-find over the corners of the faces (a corner is named by the half-edge that
-/// leaves it): corners joined by folds are one vertex of their island.
-struct Corners {
-    parent: Vec<u32>,
-}
-
-impl Corners {
-    fn new(count: usize) -> Self {
-        Corners {
-            parent: (0..count as u32).collect(),
-        }
-    }
-
-    fn find(&self, mut c: u32) -> u32 {
-        while self.parent[c as usize] != c {
-            c = self.parent[c as usize];
-        }
-        c
-    }
-
-    /// Joins two classes; the lower root stays (so roots do not depend on the order
-    /// of joining).
-    fn union(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.find(a), self.find(b));
-        let (lo, hi) = (ra.min(rb), ra.max(rb));
-        self.parent[hi as usize] = lo;
-        // Keep paths short: point the first corners straight at the root.
-        self.parent[a as usize] = lo;
-        self.parent[b as usize] = lo;
-    }
-}
-
 /// The islands as they grow: every face's corners laid flat in its island's frame.
 struct Islands {
     /// The island of each face (an index into `faces`).
@@ -383,8 +351,9 @@ struct Islands {
     faces: Vec<Vec<u32>>,
     /// Flat position of each half-edge's origin in its face's island frame.
     corner: Vec<DVec2>,
-    /// Which corners are one vertex of their island.
-    joined: Corners,
+    /// Which corners are one vertex of their island: a union-find over the corners
+    /// of the faces (a corner is named by the half-edge that leaves it).
+    joined: UnionFind,
     /// Each island's convex hull.
     hull: Vec<Vec<DVec2>>,
     /// Each island's area (its faces').
@@ -427,7 +396,7 @@ impl Islands {
             of_face: (0..mesh.face_count() as u32).collect(),
             faces: (0..mesh.face_count() as u32).map(|f| vec![f]).collect(),
             corner,
-            joined: Corners::new(mesh.half_edge_count()),
+            joined: UnionFind::new(mesh.half_edge_count()),
             hull,
             grid,
             fold: vec![false; mesh.edge_count()],
@@ -450,9 +419,9 @@ impl Islands {
 
     /// True when face `x` has a corner joined to corner `c` (the same island vertex).
     fn meets_at(&self, mesh: &Mesh, x: u32, c: HalfedgeId) -> bool {
-        let root = self.joined.find(c.0);
+        let root = self.joined.root(c.0);
         mesh.face_half_edges(FaceId(x))
-            .any(|h| self.joined.find(h.0) == root)
+            .any(|h| self.joined.root(h.0) == root)
     }
 
     /// Joins the islands of edge `e`'s faces along it when the smaller one, turned
@@ -516,8 +485,8 @@ impl Islands {
         let mut pending = PendingCorners::default();
         for &hy in &joins {
             let hx = hy.twin();
-            pending.join(self.joined.find(hy.0), self.joined.find(mesh.next(hx).0));
-            pending.join(self.joined.find(mesh.next(hy).0), self.joined.find(hx.0));
+            pending.join(self.joined.root(hy.0), self.joined.root(mesh.next(hx).0));
+            pending.join(self.joined.root(mesh.next(hy).0), self.joined.root(hx.0));
         }
         if !self.cuts_left_have_room(mesh, (a, b), &joins, &turn, &pending, options)
             || !self.keeps_clear(mesh, (a, b), &turn, &pending)
@@ -612,7 +581,7 @@ impl Islands {
     ) -> bool {
         let low = tab_options(options, TAB_STEPS[TAB_STEPS.len() - 1] * options.tab_height);
         let joined_corner = |c: HalfedgeId, d: HalfedgeId| {
-            pending.root(self.joined.find(c.0)) == pending.root(self.joined.find(d.0))
+            pending.root(self.joined.root(c.0)) == pending.root(self.joined.root(d.0))
         };
         self.between(mesh, a, b)
             .filter(|(hy, _)| !joins.contains(hy))
@@ -660,9 +629,9 @@ impl Islands {
     ) -> bool {
         let may_touch = |x: u32, y: u32| {
             mesh.face_half_edges(FaceId(y)).any(|cy| {
-                let ry = pending.root(self.joined.find(cy.0));
+                let ry = pending.root(self.joined.root(cy.0));
                 mesh.face_half_edges(FaceId(x))
-                    .any(|cx| pending.root(self.joined.find(cx.0)) == ry)
+                    .any(|cx| pending.root(self.joined.root(cx.0)) == ry)
             })
         };
         let grid = &self.grid[a as usize];
@@ -705,7 +674,7 @@ impl Turn {
 }
 
 /// Corner classes a join would merge, before it is made: a small union-find over
-/// their roots in [`Corners`], so the checks can ask which corners become one vertex.
+/// their roots in the islands' corner union-find, so the checks can ask which corners become one vertex.
 #[derive(Default)]
 struct PendingCorners {
     parent: HashMap<u32, u32>,
@@ -1393,7 +1362,7 @@ fn match_numbers(mesh: &Mesh, cuts: &[EdgeId], number: &[u32], seams: bool) -> H
         (a.min(b), a.max(b))
     };
     // Cut edges meeting at a vertex between the same two islands are one seam.
-    let mut parent: Vec<u32> = (0..cuts.len() as u32).collect();
+    let mut seam_sets = UnionFind::new(cuts.len());
     let mut at_vertex: BTreeMap<(u32, (u32, u32)), u32> = BTreeMap::new();
     for (k, &e) in cuts.iter().enumerate() {
         let h = e.half_edge();
@@ -1403,7 +1372,7 @@ fn match_numbers(mesh: &Mesh, cuts: &[EdgeId], number: &[u32], seams: bool) -> H
                     slot.insert(k as u32);
                 }
                 std::collections::btree_map::Entry::Occupied(slot) => {
-                    union(&mut parent, *slot.get(), k as u32);
+                    seam_sets.union(*slot.get(), k as u32);
                 }
             }
         }
@@ -1424,7 +1393,7 @@ fn match_numbers(mesh: &Mesh, cuts: &[EdgeId], number: &[u32], seams: bool) -> H
     // Each seam's roomiest edge, seams in the order of their first edge.
     let mut roomiest: BTreeMap<u32, (u32, usize)> = BTreeMap::new();
     for (k, &e) in cuts.iter().enumerate() {
-        let seam = find(&mut parent, k as u32);
+        let seam = seam_sets.find(k as u32);
         let first = roomiest.entry(seam).or_insert((k as u32, k));
         if room(e) > room(cuts[first.1]) {
             first.1 = k;
@@ -1492,7 +1461,7 @@ fn island_faces(net: &BuiltNet, faces: &[u32], parts: &mut PanelParts) -> Vec<(E
         let f = FaceId(f);
         let mut facet = Vec::new();
         for h in mesh.face_half_edges(f) {
-            let key = net.islands.joined.find(h.0);
+            let key = net.islands.joined.root(h.0);
             facet.push(*vertex_of.entry(key).or_insert_with(|| {
                 parts.vertices.push(mesh.position(mesh.origin(h)));
                 (parts.vertices.len() - 1) as u32

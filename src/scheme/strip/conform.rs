@@ -9,7 +9,7 @@ use super::band::Strip;
 use super::distance::has_area;
 use super::surface::{cycle_pairs, edge_uses, renumbered};
 use crate::mesh::distance::segment_distance;
-use crate::mesh::soup::{find, union};
+use crate::union_find::UnionFind;
 
 /// How far a point may be from an outline edge and count as on it (mm).
 const ON_EDGE: f64 = 1e-6;
@@ -106,14 +106,14 @@ fn weld_near(strips: &mut [Strip]) {
 /// rung without length (where its two curves touch) stays: its two triangles are the
 /// strip's only link there.
 fn collapse_short_edges(strip: &mut Strip) {
-    let mut parent: Vec<u32> = (0..strip.points.len() as u32).collect();
+    let mut sets = UnionFind::new(strip.points.len());
     let mut any = false;
     let uses = edge_uses(&strip.triangles);
     for t in &strip.triangles {
         for (a, b) in cycle_pairs(t) {
             let outline = uses[&(a.min(b), a.max(b))] == 1;
             if outline && strip.points[a as usize] == strip.points[b as usize] {
-                union(&mut parent, a, b);
+                sets.union(a, b);
                 any = true;
             }
         }
@@ -124,7 +124,7 @@ fn collapse_short_edges(strip: &mut Strip) {
     let corners: Vec<[u32; 3]> = strip
         .triangles
         .iter()
-        .map(|t| t.map(|v| find(&mut parent, v)))
+        .map(|t| t.map(|v| sets.find(v)))
         .filter(|t| t[0] != t[1] && t[1] != t[2] && t[2] != t[0])
         .collect();
     let (ids, corners) = renumbered(&corners);

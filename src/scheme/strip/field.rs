@@ -7,7 +7,7 @@ use std::collections::BTreeMap;
 use glam::DVec3;
 
 use super::surface::{rims, Triangles};
-use crate::mesh::soup::{find, union};
+use crate::union_find::UnionFind;
 
 /// The field of each connected part of `surface`, from 0 to 1. On a closed part, or an
 /// open tube, the harmonic field between two poles (0 at one, 1 at the other, the
@@ -412,17 +412,17 @@ fn cotangent_weights(surface: &Triangles) -> Vec<(u32, u32, f64)> {
 /// increasing order, the parts by their first point.
 fn parts(surface: &Triangles) -> Vec<Vec<u32>> {
     let n = surface.points.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     let mut used = vec![false; n];
     for t in &surface.corners {
         for k in 0..3 {
             used[t[k] as usize] = true;
-            union(&mut parent, t[k], t[(k + 1) % 3]);
+            sets.union(t[k], t[(k + 1) % 3]);
         }
     }
     let mut groups: BTreeMap<u32, Vec<u32>> = BTreeMap::new();
     for v in (0..n as u32).filter(|&v| used[v as usize]) {
-        let r = find(&mut parent, v);
+        let r = sets.find(v);
         groups.entry(r).or_default().push(v);
     }
     groups.into_values().collect()

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use super::patch::{Cover, Patch};
 use super::slices::shortest_bridge;
 use super::surface::{boundary_loops, cycle_pairs, edge_uses, renumbered, Triangles};
-use crate::mesh::soup::{find, union};
+use crate::union_find::UnionFind;
 
 /// What cutting a patch across gives.
 pub(super) enum Sectors {
@@ -199,7 +199,7 @@ fn joined_triangles(
     corners: &[[u32; 3]],
     cut: &std::collections::BTreeSet<(u32, u32)>,
 ) -> Vec<Vec<usize>> {
-    let mut parent: Vec<u32> = (0..corners.len() as u32).collect();
+    let mut sets = UnionFind::new(corners.len());
     let mut first: BTreeMap<(u32, u32), u32> = BTreeMap::new();
     for (k, t) in corners.iter().enumerate() {
         for (a, b) in cycle_pairs(t) {
@@ -208,7 +208,9 @@ fn joined_triangles(
                 continue;
             }
             match first.get(&edge) {
-                Some(&other) => union(&mut parent, other, k as u32),
+                Some(&other) => {
+                    sets.union(other, k as u32);
+                }
                 None => {
                     first.insert(edge, k as u32);
                 }
@@ -217,7 +219,7 @@ fn joined_triangles(
     }
     let mut groups: BTreeMap<u32, Vec<usize>> = BTreeMap::new();
     for k in 0..corners.len() {
-        let root = find(&mut parent, k as u32);
+        let root = sets.find(k as u32);
         groups.entry(root).or_default().push(k);
     }
     let mut groups: Vec<Vec<usize>> = groups.into_values().collect();

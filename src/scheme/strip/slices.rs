@@ -9,7 +9,7 @@ use glam::DVec3;
 use super::band::{band_facing, ring_facing, Strip};
 use super::patch::Patch;
 use super::surface::{boundary_loops, chains, cycle_pairs, kept_points, renumbered, Triangles};
-use crate::mesh::soup::{find, union};
+use crate::union_find::UnionFind;
 
 /// Where a point of the sliced surface comes from: a corner of the surface, or where
 /// a level crosses one of its edges (the edge by its corners, lower first).
@@ -165,7 +165,7 @@ impl Slices {
     /// The regions of the bands `wanted` takes, in band order and then by their first
     /// piece.
     fn regions_where(&self, wanted: impl Fn(usize) -> bool) -> Vec<Region> {
-        let mut parent: Vec<u32> = (0..self.pieces.len() as u32).collect();
+        let mut sets = UnionFind::new(self.pieces.len());
         let mut first_by_edge: BTreeMap<(u32, u32), usize> = BTreeMap::new();
         for (k, (band, corners)) in self.pieces.iter().enumerate() {
             if !wanted(*band) {
@@ -179,7 +179,7 @@ impl Slices {
                     std::collections::btree_map::Entry::Occupied(e) => {
                         let other = *e.get();
                         if self.pieces[other].0 == *band {
-                            union(&mut parent, other as u32, k as u32);
+                            sets.union(other as u32, k as u32);
                         }
                     }
                 }
@@ -187,7 +187,7 @@ impl Slices {
         }
         let mut members: BTreeMap<(usize, u32), Vec<usize>> = BTreeMap::new();
         for k in (0..self.pieces.len()).filter(|&k| wanted(self.pieces[k].0)) {
-            let r = find(&mut parent, k as u32);
+            let r = sets.find(k as u32);
             members.entry((self.pieces[k].0, r)).or_default().push(k);
         }
         members
