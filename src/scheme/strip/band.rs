@@ -1,7 +1,7 @@
-//! A strip: the band of triangles between two curves that bends least (the dynamic
-//! programme of the strip paper), laid flat and cut at its rungs into pieces that fit.
+//! A strip: the band of triangles between two curves, or two loops, that bends least
+//! (the dynamic programme of the strip paper).
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 /// A band of triangles between two curves, each triangle sharing a rung (an edge from
 /// one curve to the other) with the next: its corners, those of the first curve
@@ -205,14 +205,8 @@ impl Rungs<'_> {
 
 /// The band between two loops, `p` below and `q` above, running the same way round:
 /// cut open at the rung from `p`'s first point to the nearest point of `q`, which
-/// then starts and ends both curves.
-#[cfg_attr(not(test), allow(dead_code))]
-fn ring(p: &[DVec3], q: &[DVec3]) -> Strip {
-    ring_facing(p, q, None)
-}
-
-/// [`ring`], with the surface's normal at each point of `p` and `q` as
-/// [`band_facing`] takes them.
+/// then starts and ends both curves. With `normals`, the surface's normal at each
+/// point of `p` and `q`, as [`band_facing`] takes them.
 pub(super) fn ring_facing(
     p: &[DVec3],
     q: &[DVec3],
@@ -241,122 +235,12 @@ pub(super) fn ring_facing(
     band_facing(&open(p, 0), &open(q, start), facing.as_deref())
 }
 
-/// The strip laid flat: a point per corner, each triangle placed against the rung it
-/// shares with the one before, counter-clockwise as seen from outside, so every edge
-/// keeps its length.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(super) fn unroll(strip: &Strip) -> Vec<DVec2> {
-    let mut flat: Vec<Option<DVec2>> = vec![None; strip.points.len()];
-    let length = |a: u32, b: u32| strip.points[a as usize].distance(strip.points[b as usize]);
-    for (n, t) in strip.triangles.iter().enumerate() {
-        if n == 0 {
-            let [a, b, _] = *t;
-            flat[a as usize] = Some(DVec2::ZERO);
-            flat[b as usize] = Some(DVec2::new(length(a, b), 0.0));
-        }
-        // Turn the triangle so that its corner not yet placed comes last.
-        let Some(r) = (0..3).find(|&r| flat[t[(r + 2) % 3] as usize].is_none()) else {
-            continue;
-        };
-        let [a, b, c] = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
-        let (Some(pa), Some(pb)) = (flat[a as usize], flat[b as usize]) else {
-            continue;
-        };
-        flat[c as usize] = Some(apex(pa, pb, length(a, c), length(b, c)));
-    }
-    flat.into_iter().map(Option::unwrap_or_default).collect()
-}
-
-/// The strip cut at rungs into pieces, each a run of its triangles (as ranges of
-/// them), each as long as it can be while its unrolled shape (`flat`, from
-/// [`unroll`]) `fits` and does not overlap itself. A lone triangle that does not fit
-/// is a piece of its own.
-#[cfg_attr(not(test), allow(dead_code))]
-fn pieces(
-    strip: &Strip,
-    flat: &[DVec2],
-    fits: impl Fn(&[DVec2]) -> bool,
-) -> Vec<std::ops::Range<usize>> {
-    let corners = |t: usize| strip.triangles[t].map(|i| flat[i as usize]);
-    let mut pieces = Vec::new();
-    let mut start = 0;
-    let mut points: Vec<DVec2> = Vec::new();
-    for t in 0..strip.triangles.len() {
-        let new = corners(t);
-        let mut longer = points.clone();
-        longer.extend(new);
-        let overlaps = (start..t).any(|s| triangles_overlap(corners(s), new));
-        if t > start && (overlaps || !fits(&longer)) {
-            pieces.push(start..t);
-            start = t;
-            longer = new.to_vec();
-        }
-        points = longer;
-    }
-    if start < strip.triangles.len() {
-        pieces.push(start..strip.triangles.len());
-    }
-    pieces
-}
-
-/// Whether `points` fit in a `width` × `height` rectangle turned by one of `steps`
-/// equal steps of a half turn.
-#[cfg_attr(not(test), allow(dead_code))]
-fn fits_turned(points: &[DVec2], width: f64, height: f64, steps: u32) -> bool {
-    (0..steps.max(1)).any(|k| {
-        let turn = DVec2::from_angle(std::f64::consts::PI * k as f64 / steps.max(1) as f64);
-        let (lo, hi) = points.iter().fold(
-            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
-            |(lo, hi), &p| {
-                let q = turn.rotate(p);
-                (lo.min(q), hi.max(q))
-            },
-        );
-        let size = hi - lo;
-        (size.x <= width && size.y <= height) || (size.x <= height && size.y <= width)
-    })
-}
-
-/// Whether the insides of two triangles overlap (touching along an edge or at a
-/// corner does not count): no side of either separates them.
-fn triangles_overlap(a: [DVec2; 3], b: [DVec2; 3]) -> bool {
-    let scale = a
-        .iter()
-        .chain(&b)
-        .map(|p| p.abs().max_element())
-        .fold(1.0, f64::max);
-    let slack = 1e-9 * scale;
-    let separates = |t: [DVec2; 3], other: [DVec2; 3]| {
-        (0..3).any(|k| {
-            let (p, q) = (t[k], t[(k + 1) % 3]);
-            let edge = q - p;
-            let inward = (t[(k + 2) % 3] - p).perp_dot(edge).signum();
-            other
-                .iter()
-                .all(|&r| (r - p).perp_dot(edge) * inward <= slack * edge.length())
-        })
-    };
-    !separates(a, b) && !separates(b, a)
-}
-
-/// The point at distances `ac` from `a` and `bc` from `b`, to the left of `a`→`b`.
-fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
-    let ab = b.distance(a);
-    if ab == 0.0 {
-        return a;
-    }
-    let along = (ac * ac - bc * bc + ab * ab) / (2.0 * ab);
-    let across = (ac * ac - along * along).max(0.0).sqrt();
-    let x = (b - a) / ab;
-    a + along * x + across * x.perp()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::scheme::strip::conform::outline_of;
     use crate::scheme::strip::distance::one_way_distance;
-    use crate::scheme::strip::test_shapes::{tube, two_lines};
+    use crate::scheme::strip::test_shapes::{tube, two_lines, unroll};
 
     #[test]
     fn the_band_between_a_cylinders_rims_is_its_surface_and_unrolls_to_its_rectangle() {
@@ -366,7 +250,7 @@ mod tests {
             .iter()
             .map(|&h| tube.points.iter().copied().filter(|p| p.z == h).collect())
             .collect();
-        let strip = ring(&rims[0], &rims[1]);
+        let strip = ring_facing(&rims[0], &rims[1], None);
         assert_eq!(strip.triangles.len(), 2 * around);
         // Every corner on the outline: no vertex inside the band.
         let outline = outline_of(&strip);
@@ -413,54 +297,6 @@ mod tests {
             let [a, b, c] = t.map(|i| strip.points[i as usize]);
             let normal = (b - a).cross(c - a);
             assert!(normal.z > 0.0, "counter-clockwise: {normal}");
-        }
-    }
-
-    #[test]
-    fn a_long_strip_is_cut_into_pieces_that_fit_and_a_winding_one_where_it_would_overlap() {
-        // A cylinder 300 mm round, 50 mm tall: unrolled, a band 1.88 m long.
-        let tube = tube(64, 1, 50.0, |_| 300.0);
-        let rims: Vec<Vec<DVec3>> = [0.0, 50.0]
-            .iter()
-            .map(|&h| tube.points.iter().copied().filter(|p| p.z == h).collect())
-            .collect();
-        let strip = ring(&rims[0], &rims[1]);
-        let flat = unroll(&strip);
-        let fits = |p: &[DVec2]| fits_turned(p, 600.0, 400.0, 36);
-        let cut = pieces(&strip, &flat, fits);
-        // Even laid along the sheet's diagonal (721 mm), a piece holds under 0.4 of it.
-        assert!(cut.len() >= 3, "{cut:?}");
-        assert_eq!(cut.first().map(|r| r.start), Some(0));
-        assert_eq!(cut.last().map(|r| r.end), Some(strip.triangles.len()));
-        for pair in cut.windows(2) {
-            assert_eq!(pair[0].end, pair[1].start);
-        }
-        for piece in &cut {
-            let points: Vec<DVec2> = strip.triangles[piece.clone()]
-                .iter()
-                .flatten()
-                .map(|&i| flat[i as usize])
-                .collect();
-            assert!(fits(&points));
-        }
-        // A band one and a half times round a circle unrolls onto itself.
-        let turn = |k: usize, r: f64| {
-            let a = 3.0 * std::f64::consts::PI * k as f64 / 60.0;
-            DVec3::new(r * a.cos(), r * a.sin(), 0.0)
-        };
-        let p: Vec<DVec3> = (0..=60).map(|k| turn(k, 100.0)).collect();
-        let q: Vec<DVec3> = (0..=60).map(|k| turn(k, 110.0)).collect();
-        let winding = band(&q, &p);
-        let flat = unroll(&winding);
-        let cut = pieces(&winding, &flat, |_| true);
-        assert_eq!(cut.len(), 2, "{cut:?}");
-        for piece in &cut {
-            for s in piece.clone() {
-                for t in piece.clone().filter(|&t| t > s) {
-                    let corners = |k: usize| winding.triangles[k].map(|i| flat[i as usize]);
-                    assert!(!triangles_overlap(corners(s), corners(t)), "{s} {t}");
-                }
-            }
         }
     }
 }

@@ -8,7 +8,6 @@ use rayon::prelude::*;
 use super::band::{strip_soup, Strip};
 use super::conform::{conform, runs_back};
 use super::distance::distance_beyond;
-use super::field::{ridged, Closed};
 use super::patch::{Cover, Patch, RunsBack};
 use super::sectors::Sectors;
 use super::slices::{Region, Slices};
@@ -46,27 +45,10 @@ pub(super) const STAYS_OFF: &str = "mm from the surface";
 /// (a ring round a body strays where the body is sharpest, and the rest of it need not
 /// be split with it), grown in bands from its lower curve up where it is a sector or a
 /// cap round a pole, else split in halves (quarters where no one strip could be built,
-/// as on a closed part); each sector and band on its own, until none strays.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(super) fn strips_within(
-    surface: &Triangles,
-    field: &[f64],
-    tolerance: f64,
-    sector_length: f64,
-) -> Result<Banded, String> {
-    let ridged = ridged(surface, Closed::Harmonic);
-    strips_ridged(
-        surface,
-        field,
-        tolerance,
-        sector_length,
-        ridged,
-        RunsBack::Welded,
-    )
-}
-
-/// [`strips_within`], where the field has ridges (a distance's,
-/// [`field_of`](super::field::field_of)) or not.
+/// as on a closed part); each sector and band on its own, until none strays. `ridged`
+/// tells whether the field has ridges (a distance's,
+/// [`field_of`](super::field::field_of)), `runs_back` when a strip that may fold is
+/// found running back over itself.
 pub(super) fn strips_ridged(
     surface: &Triangles,
     field: &[f64],
@@ -405,7 +387,7 @@ fn off_values(mut level: f64, sorted: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::strip::field::two_pole_field;
+    use crate::scheme::strip::field::{field_of, Closed};
     use crate::scheme::strip::test_shapes::{
         self, along, check_strips, check_strips_cut, sphere, tube,
     };
@@ -413,7 +395,7 @@ mod tests {
     #[test]
     fn an_open_tube_between_its_rims_is_one_strip_and_a_cone_too() {
         let tube = tube(32, 6, 120.0, |_| 40.0);
-        let field = two_pole_field(&tube).unwrap();
+        let field = field_of(&tube, Closed::Harmonic).unwrap();
         // Held at 0 and 1 on its rims (either way round), linear in between.
         let up = field[0] == 0.0;
         for (p, f) in tube.points.iter().zip(&field) {
@@ -422,7 +404,10 @@ mod tests {
         }
         assert_eq!(check_strips(&tube, &field, 1.0), 1);
         let cone = test_shapes::tube(32, 6, 120.0, |h| 60.0 - 0.3 * h);
-        assert_eq!(check_strips(&cone, &two_pole_field(&cone).unwrap(), 1.0), 1);
+        assert_eq!(
+            check_strips(&cone, &field_of(&cone, Closed::Harmonic).unwrap(), 1.0),
+            1
+        );
     }
 
     #[test]
@@ -432,7 +417,7 @@ mod tests {
         let strips = check_strips(&sphere, &along(&sphere, DVec3::new(0.3, 0.2, 0.93)), 2.0);
         assert!(strips >= 3, "{strips}");
         // Between two poles, the same.
-        let field = two_pole_field(&sphere).unwrap();
+        let field = field_of(&sphere, Closed::Harmonic).unwrap();
         let whole = check_strips(&sphere, &field, 2.0);
         // Rings longer than 200 mm cut across into sectors, each split on its own.
         let cut = check_strips_cut(&sphere, &field, 2.0, 200.0);

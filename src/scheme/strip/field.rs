@@ -9,19 +9,6 @@ use glam::DVec3;
 use super::surface::{rims, Triangles};
 use crate::union_find::UnionFind;
 
-/// The field of each connected part of `surface`, from 0 to 1. On a closed part, or an
-/// open tube, the harmonic field between two poles (0 at one, 1 at the other, the
-/// cotangent Laplacian's zero elsewhere; faer's sparse Cholesky): level curves that
-/// run round the part like parallels between its ends, with saddles only where its
-/// shape needs them. The poles are the part's two points farthest apart, or the
-/// tube's rims. On a part with other rims (holes, like a scan's), the distance from
-/// them all ([`distance_from`]): a harmonic field crowds its levels along a ragged rim
-/// or between two rims close together, too close for a strip between them.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(super) fn two_pole_field(surface: &Triangles) -> Result<Vec<f64>, String> {
-    field_of(surface, Closed::Harmonic)
-}
-
 /// What the field is on a closed part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) enum Closed {
@@ -31,7 +18,16 @@ pub(super) enum Closed {
     Distance,
 }
 
-/// [`two_pole_field`], with `closed` parts' field as asked.
+/// The field of each connected part of `surface`, from 0 to 1. On an open tube or an
+/// annulus (two rims no point of the part lies farther from than they lie apart), the
+/// harmonic field between its rims (0 at one, 1 at the other, the cotangent
+/// Laplacian's zero elsewhere; faer's sparse Cholesky): level curves that run round
+/// the part like parallels between its ends, with saddles only where its shape needs
+/// them. On a closed part, as `closed` asks: the harmonic field between its two points
+/// farthest apart, or the distance from one of them. On a part with other rims (one,
+/// or holes, like a scan's), the distance from them all ([`distance_from`]): a
+/// harmonic field crowds its levels along a ragged rim or between two rims close
+/// together, too close for a strip between them.
 pub(super) fn field_of(surface: &Triangles, closed: Closed) -> Result<Vec<f64>, String> {
     let n = surface.points.len();
     let weights = cotangent_weights(surface);
@@ -455,7 +451,7 @@ mod tests {
     #[test]
     fn an_evened_field_steps_evenly_along_the_surface() {
         let cone = tube(48, 40, 100.0, |h| 10.0 + 1.5 * h);
-        let field = two_pole_field(&cone).unwrap();
+        let field = field_of(&cone, Closed::Harmonic).unwrap();
         let even = evened(&cone, &field);
         let (lo, hi) = (
             even.iter().copied().fold(f64::INFINITY, f64::min),
@@ -486,7 +482,7 @@ mod tests {
             .corners
             .retain(|t| !removed.iter().any(|h| h.iter().all(|v| t.contains(v))));
         assert_eq!(rims(&holed).len(), 2);
-        let field = two_pole_field(&holed).unwrap();
+        let field = field_of(&holed, Closed::Harmonic).unwrap();
         let far = field.iter().position(|&f| f == 1.0).expect("a pole at 1");
         assert!(
             holed.points[far].z > 50.0,
@@ -521,7 +517,7 @@ mod tests {
         });
         let holed = holed.rims_apart();
         assert_eq!(rims(&holed).len(), 3);
-        let field = two_pole_field(&holed).unwrap();
+        let field = field_of(&holed, Closed::Harmonic).unwrap();
         let segments: Vec<(DVec3, DVec3)> = rims(&holed)
             .iter()
             .flat_map(|r| {

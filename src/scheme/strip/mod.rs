@@ -3,14 +3,14 @@
 //! between strips.
 //!
 //! The strips follow the level curves of a field between two poles of each part of
-//! the model, or from its holes' rims (`two_pole_field`); between two neighbouring curves, the band of
-//! triangles that bends least (every corner on one of the two curves, so no vertex is
-//! inside the band and it unrolls exactly; the dynamic programme of the strip paper,
-//! `003`). A band whose strip strays from the model further than `--max-deviation`,
+//! the model, or from its holes' rims (`field_of`); between two neighbouring curves,
+//! the band of triangles that bends least (every corner on one of the two curves, so
+//! no vertex is inside the band and it unrolls exactly; the dynamic programme of the
+//! strip paper, `003`). A band whose strip strays from the model further than `--max-deviation`,
 //! measured both ways, is cut across into sectors about as long as the sheet (along
 //! the field's rise, from one curve to the other), and each sector is covered from its
 //! lower curve up by bands as wide as keep their strips within, so that a sharp part
-//! of a ring (an ear) does not narrow the strips round the rest (`strips_within`).
+//! of a ring (an ear) does not narrow the strips round the rest (`strips_ridged`).
 //! Where a sector meets one split differently, each point of one on the other's edge
 //! becomes a corner of both. The strips are welded into one surface where they share
 //! their curves' points; the net scheme's islands then grow along each strip's rungs

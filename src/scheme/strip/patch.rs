@@ -16,11 +16,11 @@ pub(super) struct Patch {
     pub(super) ends: [f64; 2],
 }
 
-/// How [`strips_within`](super::cover::strips_within) covers the surface.
+/// How [`strips_ridged`](super::cover::strips_ridged) covers the surface.
 #[derive(Clone, Copy)]
 pub(super) struct Cover {
     /// The field is a distance from rims, its saddles ridges
-    /// ([`two_pole_field`](super::field::two_pole_field)).
+    /// ([`field_of`](super::field::field_of)).
     pub(super) ridged: bool,
     /// The distance a strip may lie from its part, at any point.
     pub(super) within: f64,

@@ -224,8 +224,7 @@ impl Slices {
 impl Slices {
     /// Which points the strips keep: the surface's corners `corner_kept` says, and of
     /// each level's curves the fewest points within `tolerance` of them
-    /// ([`simplify`](super::surface::simplify)), the same for the regions on either
-    /// side of the curve.
+    /// ([`kept_points`]), the same for the regions on either side of the curve.
     pub(super) fn kept(&self, tolerance: f64, corner_kept: &dyn Fn(u32) -> bool) -> Vec<bool> {
         let mut keep: Vec<bool> = self
             .origins
@@ -596,7 +595,40 @@ fn surface_edge(a: Origin, b: Origin) -> (u32, u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::strip::test_shapes::{along, check_strips, check_strips_cut, torus};
+    use crate::scheme::strip::test_shapes::{
+        along, check_strips, check_strips_cut, heights, torus, tube,
+    };
+
+    /// The crossings of `field`'s level `level` on `surface` that [`Slices::kept`]
+    /// keeps with a tolerance no curve strays beyond: each closed curve's first point
+    /// and two more, each open curve's ends.
+    fn kept_crossings(surface: &Triangles, field: &[f64], level: f64) -> Vec<DVec3> {
+        let slices = Slices::new(surface, field, vec![-1e3, level, 1e3], None);
+        let kept = slices.kept(1e9, &|_| false);
+        (0..slices.points.len() as u32)
+            .filter(|&i| kept[i as usize])
+            .map(|i| {
+                assert_eq!(slices.level_of(i), Some(1), "a point off the level kept");
+                slices.point(i)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_level_round_a_tube_is_one_loop_and_across_it_two_curves_from_rim_to_rim() {
+        let tube = tube(24, 4, 100.0, |_| 50.0);
+        let round = kept_crossings(&tube, &heights(&tube), 37.5);
+        assert_eq!(round.len(), 3, "one loop: {round:?}");
+        assert!(round.iter().all(|p| (p.z - 37.5).abs() < 1e-9));
+        let across: Vec<f64> = tube.points.iter().map(|p| p.x).collect();
+        let ends = kept_crossings(&tube, &across, 10.0);
+        assert_eq!(ends.len(), 4, "two open curves: {ends:?}");
+        for p in &ends {
+            assert!((p.x - 10.0).abs() < 1e-9, "{p}");
+            let off = p.z.abs().min((p.z - 100.0).abs());
+            assert!(off < 1e-9, "an end off the rims: {p}");
+        }
+    }
 
     #[test]
     fn strips_of_a_torus_bridge_its_saddles() {

@@ -1,5 +1,5 @@
 //! The surface the strips cover, as triangles over shared corners, and what is read
-//! off it: its rims and edges, and the level curves of a field on it, simplified.
+//! off it: its rims and edges, and its curves chained from their links and simplified.
 
 use std::collections::BTreeMap;
 
@@ -80,52 +80,6 @@ impl Triangles {
     }
 }
 
-/// A curve on the surface: a polyline, closed (its last point joins its first) or
-/// open (its ends on the surface's boundary).
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct Curve {
-    pub(super) points: Vec<DVec3>,
-    pub(super) closed: bool,
-}
-
-/// The curves where `field` (a value per point of `surface`, linear over each
-/// triangle) equals `level`, each running with the side above the level on its left
-/// seen from outside. A point exactly at the level counts as above, so every curve
-/// crosses edges between a point below and one above, never a corner.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(super) fn level_curves(surface: &Triangles, field: &[f64], level: f64) -> Vec<Curve> {
-    let above = |v: u32| field[v as usize] >= level;
-    let key = |a: u32, b: u32| (a.min(b), a.max(b));
-    // In a counter-clockwise triangle, the curve runs from the edge leaving the lone
-    // corner above to the edge entering it (the corner on its left), and the other
-    // way round a lone corner below.
-    let mut next: BTreeMap<(u32, u32), (u32, u32)> = BTreeMap::new();
-    for &[a, b, c] in &surface.corners {
-        for (x, y, z) in [(a, b, c), (b, c, a), (c, a, b)] {
-            if above(x) != above(y) && above(x) != above(z) {
-                let (leaving, entering) = (key(x, y), key(z, x));
-                if above(x) {
-                    next.insert(leaving, entering);
-                } else {
-                    next.insert(entering, leaving);
-                }
-            }
-        }
-    }
-    let crossing = |(a, b): (u32, u32)| {
-        let (fa, fb) = (field[a as usize], field[b as usize]);
-        let t = ((level - fa) / (fb - fa)).clamp(0.0, 1.0);
-        surface.points[a as usize].lerp(surface.points[b as usize], t)
-    };
-    chains(&next)
-        .into_iter()
-        .map(|(edges, closed)| Curve {
-            points: edges.into_iter().map(crossing).collect(),
-            closed,
-        })
-        .collect()
-}
-
 /// The chains of `next` (each key to the one after it): the open ones from the keys
 /// nothing leads to, then the loops, each as its keys and whether it closes.
 pub(super) fn chains<K: Ord + Copy>(next: &BTreeMap<K, K>) -> Vec<(Vec<K>, bool)> {
@@ -161,25 +115,10 @@ pub(super) fn chains<K: Ord + Copy>(next: &BTreeMap<K, K>) -> Vec<(Vec<K>, bool)
     chains
 }
 
-/// `curve` with the fewest points (Douglas–Peucker) that keep every dropped point
-/// within `tolerance` of the polyline kept; a loop keeps its first point and the
-/// point farthest from it.
-#[cfg_attr(not(test), allow(dead_code))]
-pub(super) fn simplify(curve: &Curve, tolerance: f64) -> Curve {
-    let keep = kept_points(&curve.points, curve.closed, tolerance);
-    Curve {
-        points: curve
-            .points
-            .iter()
-            .zip(&keep)
-            .filter(|(_, &k)| k)
-            .map(|(&q, _)| q)
-            .collect(),
-        closed: curve.closed,
-    }
-}
-
-/// Which of the polyline's points [`simplify`] keeps.
+/// Which of the points of the polyline `p` (a loop where `closed`) to keep: those
+/// Douglas–Peucker keeps so that every point dropped lies within `tolerance` of the
+/// polyline kept. A loop keeps its first point, the point farthest from it and the
+/// point farthest from those two.
 pub(super) fn kept_points(p: &[DVec3], closed: bool, tolerance: f64) -> Vec<bool> {
     if p.len() < 3 {
         return vec![true; p.len()];
@@ -299,58 +238,28 @@ pub(super) fn renumbered(corners: &[[u32; 3]]) -> (Vec<u32>, Vec<[u32; 3]>) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::strip::test_shapes::{heights, tube};
-
-    #[test]
-    fn a_level_of_a_tube_is_one_loop_round_it_with_the_top_on_its_left() {
-        let tube = tube(24, 4, 100.0, |_| 50.0);
-        let curves = level_curves(&tube, &heights(&tube), 37.5);
-        assert_eq!(curves.len(), 1);
-        let loop_ = &curves[0];
-        assert!(loop_.closed);
-        assert_eq!(loop_.points.len(), 48, "one point per crossed edge");
-        for p in &loop_.points {
-            assert!((p.z - 37.5).abs() < 1e-9);
-        }
-        // Running counter-clockwise seen from above (+z): the top on its left seen
-        // from outside.
-        let turn: f64 = loop_
-            .points
-            .iter()
-            .zip(loop_.points.iter().cycle().skip(1))
-            .map(|(a, b)| a.x * b.y - a.y * b.x)
-            .sum();
-        assert!(turn > 0.0, "{turn}");
-    }
-
-    #[test]
-    fn a_level_across_an_open_tube_is_two_curves_from_rim_to_rim() {
-        let tube = tube(24, 4, 100.0, |_| 50.0);
-        let across: Vec<f64> = tube.points.iter().map(|p| p.x).collect();
-        let curves = level_curves(&tube, &across, 10.0);
-        assert_eq!(curves.len(), 2, "{curves:?}");
-        for c in &curves {
-            assert!(!c.closed);
-            let ends = [c.points[0].z, c.points[c.points.len() - 1].z];
-            assert!(ends == [0.0, 100.0] || ends == [100.0, 0.0], "{ends:?}");
-            assert!(c.points.iter().all(|p| (p.x - 10.0).abs() < 1e-9));
-        }
-    }
 
     #[test]
     fn simplifying_keeps_every_point_within_the_tolerance() {
-        let tube = tube(64, 1, 10.0, |_| 100.0);
-        let loop_ = &level_curves(&tube, &heights(&tube), 5.0)[0];
-        let coarse = simplify(loop_, 2.0);
-        assert!(
-            coarse.points.len() < loop_.points.len() / 2,
-            "{}",
-            coarse.points.len()
-        );
-        let n = coarse.points.len();
-        for p in &loop_.points {
+        // A loop of 128 points round a circle of radius 100 mm, as a level of a tube.
+        let circle: Vec<DVec3> = (0..128)
+            .map(|k| {
+                let a = std::f64::consts::TAU * k as f64 / 128.0;
+                DVec3::new(100.0 * a.cos(), 100.0 * a.sin(), 5.0)
+            })
+            .collect();
+        let keep = kept_points(&circle, true, 2.0);
+        let coarse: Vec<DVec3> = circle
+            .iter()
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+            .map(|(&p, _)| p)
+            .collect();
+        assert!(coarse.len() < circle.len() / 2, "{}", coarse.len());
+        let n = coarse.len();
+        for p in &circle {
             let d = (0..n)
-                .map(|k| segment_distance(*p, coarse.points[k], coarse.points[(k + 1) % n]))
+                .map(|k| segment_distance(*p, coarse[k], coarse[(k + 1) % n]))
                 .fold(f64::INFINITY, f64::min);
             assert!(d <= 2.0 + 1e-9, "{d}");
         }

@@ -1,16 +1,18 @@
 //! Shapes and checks the strip scheme's unit tests share: tubes, spheres and tori as
-//! triangles, fields along an axis, and the check that strips cover a surface within
-//! a tolerance, unroll exactly and meet point for point.
+//! triangles, fields along an axis, strips laid flat, and the check that strips cover
+//! a surface within a tolerance, unroll exactly and meet point for point.
 
 use std::collections::BTreeMap;
 use std::f64::consts::TAU;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use super::band::{strip_soup, unroll};
+use super::band::{strip_soup, Strip};
 use super::conform::outline_of;
-use super::cover::strips_within;
+use super::cover::{strips_ridged, Banded};
 use super::distance::one_way_distance;
+use super::field::{ridged, Closed};
+use super::patch::RunsBack;
 use super::surface::{cycle_pairs, rims, Triangles};
 
 /// A tube of `around` × `along` quads split into triangles, radius `r(h)` at
@@ -93,7 +95,7 @@ pub(super) fn check_strips_cut(
     sector_length: f64,
 ) -> usize {
     let clock = std::time::Instant::now();
-    let banded = strips_within(surface, field, tolerance, sector_length).unwrap();
+    let banded = banded(surface, field, tolerance, sector_length).unwrap();
     eprintln!(
         "{} strips, deviation {:.3} in {:?}",
         banded.strips.len(),
@@ -167,6 +169,62 @@ pub(super) fn check_strips_cut(
         );
     }
     banded.strips.len()
+}
+
+/// The strips of `surface` within `tolerance`, as the scheme covers a surface whose
+/// closed parts have a harmonic field, bands cut into sectors `sector_length` long.
+pub(super) fn banded(
+    surface: &Triangles,
+    field: &[f64],
+    tolerance: f64,
+    sector_length: f64,
+) -> Result<Banded, String> {
+    let ridged = ridged(surface, Closed::Harmonic);
+    strips_ridged(
+        surface,
+        field,
+        tolerance,
+        sector_length,
+        ridged,
+        RunsBack::Welded,
+    )
+}
+
+/// The strip laid flat: a point per corner, each triangle placed against the rung it
+/// shares with the one before, counter-clockwise as seen from outside, so every edge
+/// keeps its length.
+pub(super) fn unroll(strip: &Strip) -> Vec<DVec2> {
+    let mut flat: Vec<Option<DVec2>> = vec![None; strip.points.len()];
+    let length = |a: u32, b: u32| strip.points[a as usize].distance(strip.points[b as usize]);
+    for (n, t) in strip.triangles.iter().enumerate() {
+        if n == 0 {
+            let [a, b, _] = *t;
+            flat[a as usize] = Some(DVec2::ZERO);
+            flat[b as usize] = Some(DVec2::new(length(a, b), 0.0));
+        }
+        // Turn the triangle so that its corner not yet placed comes last.
+        let Some(r) = (0..3).find(|&r| flat[t[(r + 2) % 3] as usize].is_none()) else {
+            continue;
+        };
+        let [a, b, c] = [t[r], t[(r + 1) % 3], t[(r + 2) % 3]];
+        let (Some(pa), Some(pb)) = (flat[a as usize], flat[b as usize]) else {
+            continue;
+        };
+        flat[c as usize] = Some(apex(pa, pb, length(a, c), length(b, c)));
+    }
+    flat.into_iter().map(Option::unwrap_or_default).collect()
+}
+
+/// The point at distances `ac` from `a` and `bc` from `b`, to the left of `a`→`b`.
+fn apex(a: DVec2, b: DVec2, ac: f64, bc: f64) -> DVec2 {
+    let ab = b.distance(a);
+    if ab == 0.0 {
+        return a;
+    }
+    let along = (ac * ac - bc * bc + ab * ab) / (2.0 * ab);
+    let across = (ac * ac - along * along).max(0.0).sqrt();
+    let x = (b - a) / ab;
+    a + along * x + across * x.perp()
 }
 
 /// The height of each point along `axis`.

@@ -53,9 +53,8 @@ pub(super) struct Covering {
     pub(super) tolerance: f64,
 }
 
-/// The strips of `surface` within `tolerance`
-/// ([`strips_within`](super::cover::strips_within)), welded into one surface; where the
-/// sectors' strips of neighbouring bands overlap, every band whole.
+/// The strips of `surface` within `tolerance` ([`strips_ridged`]), welded into one
+/// surface; where the sectors' strips of neighbouring bands overlap, every band whole.
 fn covering(
     surface: &Triangles,
     field: &[f64],
