@@ -6,7 +6,7 @@
 //! temporary directory and the independent sheet checker of `tests/common` reads it
 //! back (every SVG; every DXF read back, only the first and the last for
 //! fertility and horse_quad unless `UNFOLD_FULL_DXF=1`); the geometric facts are
-//! checked at library level on the pipeline of `src/run.rs` (`common::build::pipeline`),
+//! checked at library level on the pipeline of `src/run/` (`common::build::pipeline`),
 //! with the mesh the scheme used: counts against the mesh, holes followed back to 3D,
 //! bend strips planar with rulings parallel to the edge and on the rails of the spec's
 //! formula, flaps in their face, outlines simple, unrolling isometric.

@@ -281,7 +281,7 @@ fn text_boxes(svg: &str) -> Vec<TextBox> {
             let x: f64 = attribute(tag, "x").parse().unwrap();
             let y: f64 = attribute(tag, "y").parse().unwrap();
             let size: f64 = attribute(tag, "font-size").parse().unwrap();
-            let width = unfold::export::map_page::text_width(&text, size);
+            let width = unfold::export::map::page::text_width(&text, size);
             let id = tag.contains("text-anchor=\"middle\"");
             // Ids are centred, their baseline 0.35 em below their point.
             let (left, baseline) = if id {

@@ -12,7 +12,7 @@ use crate::nest::NesterName;
 use crate::scheme::Registry;
 use crate::units::LengthUnit;
 
-use super::{LabelSide, NonPlanar};
+use super::values::{LabelSide, NonPlanar};
 use crate::export::laser::Speeds;
 pub use crate::option_default::{
     find_default, state_defaults, state_defaults_in, OptionDefault, Stated,
@@ -159,37 +159,6 @@ mod tests {
         assert_eq!(shown("simplify-mode"), "regular");
         assert_eq!(shown("speeds"), "cut=15,score=50,engrave=100,travel=300");
         assert_eq!(shown("scheme"), "half-edge");
-    }
-
-    #[test]
-    fn every_option_of_the_command_has_one_default() {
-        let registry = Registry::default();
-        let defaults = option_defaults(&registry);
-        let command = super::super::BuildOptions::command(&registry);
-        let scheme_own: Vec<String> = registry
-            .options()
-            .iter()
-            .filter_map(|a| a.get_long().map(str::to_string))
-            .collect();
-        for arg in command.get_arguments() {
-            let Some(long) = arg.get_long() else { continue };
-            if scheme_own.iter().any(|s| s == long) {
-                continue;
-            }
-            assert!(
-                find_default(&defaults, Some(long)).is_some(),
-                "--{long} has no default"
-            );
-            let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
-            assert_eq!(help.matches("[default: ").count(), 1, "--{long}: {help}");
-        }
-        for (i, d) in defaults.iter().enumerate() {
-            assert!(
-                !defaults[..i].iter().any(|e| e.long == d.long),
-                "--{} twice",
-                d.long
-            );
-        }
     }
 
     #[test]

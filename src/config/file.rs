@@ -10,9 +10,14 @@ use std::path::Path;
 
 use toml::de::{DeTable, DeValue};
 
-use super::{parse_length, parse_sheet, BuildOptions, LayerSettings, ModelOptions, TargetEdges};
+use super::layers::LayerSettings;
+use super::model::ModelOptions;
+use super::options::BuildOptions;
+use super::sheet::parse_sheet;
+use super::values::TargetEdges;
 use crate::error::{Error, Result};
 use crate::scheme::{OptionValues, Registry};
+use crate::units::parse_length;
 
 /// The message for a length or sheet written without quotes on the line at `offset`
 /// (`size = 4ft`), which TOML cannot read as a number: the key and the quoted value.
@@ -157,10 +162,11 @@ fn read_layers(
             let text_value = text_value.to_string();
             let setting = &mut layers.0[k];
             let checked = match field_name {
-                "name" => {
-                    super::check_layer_name(&text_value).map(|()| setting.name = Some(text_value))
+                "name" => super::layers::check_layer_name(&text_value)
+                    .map(|()| setting.name = Some(text_value)),
+                "color" => {
+                    super::layers::check_layer_color(&text_value).map(|c| setting.color = Some(c))
                 }
-                "color" => super::check_layer_color(&text_value).map(|c| setting.color = Some(c)),
                 "stroke-width" => {
                     parse_length(&text_value).map(|_| setting.stroke_width = Some(text_value))
                 }

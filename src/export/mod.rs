@@ -8,8 +8,6 @@ pub mod folder;
 pub mod laser;
 pub mod manifest;
 pub mod map;
-mod map_closeup;
-pub mod map_page;
 pub mod obj;
 pub mod preview;
 pub mod report;

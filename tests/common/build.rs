@@ -1,7 +1,7 @@
 //! Helpers for the end-to-end build tests of every scheme (`tests/build_*.rs`): running
 //! the binary, reading its manifest, checking every sheet of an output folder with the
 //! independent checker of this module's parent, running the library's pipeline up to the
-//! flat panels the way `src/run.rs` does, golden-file comparison, and a little plane
+//! flat panels the way `src/run/` does, golden-file comparison, and a little plane
 //! geometry written here rather than taken from the crate under test.
 
 use std::collections::{BTreeMap, BTreeSet};

@@ -8,12 +8,11 @@ use std::fmt::Write;
 
 use glam::{DVec2, DVec3};
 
-use super::fmt_mm;
-use super::map::{
-    draw_frame, project, text_lines, views, CloseUpCells, Frame, MapContext, View, CAPTION_TEXT,
-    GAP,
-};
-use super::map_page::{fit, text_width};
+use super::draw::{draw_frame, Frame};
+use super::layout::{text_lines, CloseUpCells, MapContext, CAPTION_TEXT, GAP};
+use super::page::{fit, text_width};
+use super::view::{project, views, View};
+use crate::export::fmt_mm;
 use crate::panel::surface::Patch;
 
 /// The least a close-up enlarges on the overview.
