@@ -8,7 +8,7 @@ use std::fmt::Write;
 
 use glam::DVec2;
 
-use super::{fmt_mm, Kind, Layers, SheetSink};
+use super::sink::{fmt_mm, Kind, Layers, SheetSink};
 
 /// Collects one sheet's entities; [`DxfSheet::finish`] writes the file.
 pub struct DxfSheet {

@@ -1,7 +1,7 @@
 //! The laser's time: speeds per kind, the travel between paths, and the order that
 //! keeps it short. [`super::draw_sheet`] hands the paths of each kind to [`order`],
 //! which runs them nearest first (a part's holes and inner cuts still before its
-//! outline); the [`super::Lengths`] sink measures the travel of whatever order it is
+//! outline); the [`super::sink::Lengths`] sink measures the travel of whatever order it is
 //! given.
 
 use glam::DVec2;
@@ -69,7 +69,7 @@ impl Speeds {
     }
 
     /// Seconds to run `lengths` (mm) at these speeds.
-    pub fn seconds(&self, lengths: &super::Lengths) -> f64 {
+    pub fn seconds(&self, lengths: &super::sink::Lengths) -> f64 {
         lengths.cut / self.cut
             + (lengths.score + lengths.score_valley) / self.score
             + lengths.engrave / self.engrave

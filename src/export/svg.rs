@@ -6,7 +6,7 @@ use std::fmt::Write;
 
 use glam::DVec2;
 
-use super::{fmt_mm, Kind, Layers, SheetSink};
+use super::sink::{fmt_mm, Kind, Layers, SheetSink};
 
 /// Collects one sheet's elements; [`SvgSheet::finish`] writes the document.
 pub struct SvgSheet {
