@@ -5,9 +5,8 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use super::{
-    line_error, parse_position, text_lines, Format, Group, RawModel, BAD_INDEX_FIX, TRUNCATED_FIX,
-};
+use super::model::{Format, Group, RawModel};
+use super::text::{line_error, parse_position, text_lines, BAD_INDEX_FIX, TRUNCATED_FIX};
 use crate::error::InputError;
 use crate::mesh::polygons::Polygons;
 

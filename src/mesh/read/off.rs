@@ -4,9 +4,8 @@
 
 use std::path::Path;
 
-use super::{
-    line_error, parse_position, text_lines, Format, RawModel, BAD_INDEX_FIX, TRUNCATED_FIX,
-};
+use super::model::{Format, RawModel};
+use super::text::{line_error, parse_position, text_lines, BAD_INDEX_FIX, TRUNCATED_FIX};
 use crate::error::{InputError, Location};
 use crate::mesh::polygons::Polygons;
 

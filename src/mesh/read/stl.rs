@@ -5,7 +5,8 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::{parse_coordinate, text_lines, Format, RawModel};
+use super::model::{Format, RawModel};
+use super::text::{binary_data_at, parse_coordinate, text_lines, MAX_COORDINATE, TOO_LARGE_FIX};
 use crate::error::{InputError, Location};
 use crate::mesh::polygons::Polygons;
 use crate::mesh::weld::{cluster_positions, weld_tolerance};
@@ -18,7 +19,7 @@ pub(super) fn parse(path: &Path, bytes: &[u8]) -> Result<RawModel, InputError> {
         .skip_while(|b| b.is_ascii_whitespace())
         .take(5)
         .eq(b"solid".iter())
-        && super::binary_data_at(bytes).is_none();
+        && binary_data_at(bytes).is_none();
     let binary_size = (bytes.len() >= 84).then(|| {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
         84 + 50 * n
@@ -104,12 +105,12 @@ fn read_binary(path: &Path, bytes: &[u8]) -> Result<Soup, InputError> {
                         "replace NaN or infinite coordinates with real positions",
                     ));
                 }
-                if f64::from(value).abs() > super::MAX_COORDINATE {
+                if f64::from(value).abs() > MAX_COORDINATE {
                     return Err(InputError::new(
                         path,
                         Location::Byte((start + at) as u64),
                         format!("triangle {t} has a coordinate of {value:e}, too large"),
-                        super::TOO_LARGE_FIX,
+                        TOO_LARGE_FIX,
                     ));
                 }
                 *slot = value as f64;
