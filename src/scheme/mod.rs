@@ -11,6 +11,7 @@ pub mod bracket;
 pub mod edge_panel;
 pub mod ergs;
 pub mod half_edge;
+mod kit;
 pub mod net;
 pub mod quad_edge;
 pub mod rigid;

@@ -6,7 +6,7 @@
 use glam::DVec3;
 
 use super::bracket::{bracket_panel, clear_brackets, slotted_facets, BracketSizes, Slot};
-use super::half_edge::outline_labels;
+use super::kit::labels::outline_labels;
 use super::rigid::{rigid_panels, thickest, RigidError};
 use super::{PanelOptions, SchemeError, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};

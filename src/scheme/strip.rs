@@ -23,7 +23,7 @@ use std::collections::{BTreeMap, HashMap};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-use super::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
+use super::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
 use super::net::{
     islands_along, FlatFoldArgs, IslandNames, IslandNet, NetOptions, OwnNet, FLAT_FOLD_DEG,
 };
