@@ -14,6 +14,7 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::OutlineStyle;
 use rayon::prelude::*;
 
+use super::kit::thickness::{thickness, thickness_default};
 use super::{face_band, PanelDefaults, PanelOptions};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::OptionDefault;
@@ -47,7 +48,7 @@ pub fn band_defaults() -> [OptionDefault; 5] {
         OptionDefault::value("bridge-scale", BRIDGE_SCALE),
         OptionDefault::value("flap-scale", FLAP_SCALE),
         OptionDefault::value("samples", SAMPLES),
-        super::thickness_default(),
+        thickness_default(),
         OptionDefault::value("layers", LAYERS),
     ]
 }
@@ -95,7 +96,7 @@ impl BandArgs {
         if !(1..=64).contains(&samples) {
             return Err(format!("--samples: {samples} must be between 1 and 64"));
         }
-        let thickness = super::thickness("thickness", self.thickness.as_deref(), "0mm", &panel)?;
+        let thickness = thickness("thickness", self.thickness.as_deref(), "0mm", &panel)?;
         let sandwich = match (self.layers.unwrap_or(LAYERS), thickness > 0.0) {
             (1, false) => None,
             (2, true) => Some(thickness),

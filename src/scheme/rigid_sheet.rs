@@ -7,6 +7,7 @@ use glam::DVec3;
 
 use super::bracket::{bracket_panel, clear_brackets, slotted_facets, BracketSizes, Slot};
 use super::kit::labels::outline_labels;
+use super::kit::thickness::{thickness, thickness_default};
 use super::rigid::{rigid_panels, thickest, RigidError};
 use super::{PanelOptions, SchemeError, SchemeOutput};
 use crate::mesh::{FaceId, Mesh};
@@ -55,7 +56,7 @@ pub(super) struct RigidArgs {
 pub(super) fn rigid_defaults() -> [OptionDefault; 3] {
     [
         OptionDefault::words("connectors", CONNECTORS_WORDS),
-        super::thickness_default(),
+        thickness_default(),
         OptionDefault::value("slot-clearance", SLOT_CLEARANCE),
     ]
 }
@@ -74,7 +75,7 @@ pub struct RigidSheet {
 impl RigidArgs {
     /// The options, checked: tabs only in card, brackets only in rigid sheet.
     pub(super) fn resolve(&self, panel: &PanelOptions) -> Result<RigidSheet, String> {
-        let thickness = super::thickness("thickness", self.thickness.as_deref(), "0mm", panel)?;
+        let thickness = thickness("thickness", self.thickness.as_deref(), "0mm", panel)?;
         let connectors = match (self.connectors, thickness > 0.0) {
             (Some(Connectors::Tab), true) => {
                 return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); give --connectors bracket or none".to_string())
