@@ -9,14 +9,14 @@
 //! the faces and the tab first spans the gap in its own face's plane (a bridge facet).
 //!
 //! In rigid sheet (`--thickness` above zero) nothing folds: each panel is its face cut
-//! back where a neighbour's material needs the room ([`super::rigid`]), and the panels
+//! back where a neighbour's material needs the room ([`super::rigid::cutback`]), and the panels
 //! meet edge to edge.
 
 use glam::DVec3;
 
 use super::kit::labels::outline_labels;
 use super::kit::tab::{make_tab, tab_defaults, Tab, TabArgs, TabOptions, TAB_DEFAULTS};
-use super::rigid_sheet::{
+use super::rigid::sheet::{
     rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
 };
 use super::{
@@ -401,7 +401,7 @@ mod tests {
             },
             tabs: true,
             tab_height,
-            rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
+            rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
         }
     }
 

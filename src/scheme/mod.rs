@@ -7,7 +7,6 @@
 //! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
 //! module reaches the schemes only through a [`Registry`].
 
-pub mod bracket;
 pub mod edge_panel;
 pub mod ergs;
 pub mod half_edge;
@@ -15,7 +14,6 @@ mod kit;
 pub mod net;
 pub mod quad_edge;
 pub mod rigid;
-pub mod rigid_sheet;
 pub mod sandwich;
 pub mod strip;
 pub mod winged_edge;

@@ -28,7 +28,7 @@ use std::collections::{BTreeMap, HashMap};
 use glam::{DVec2, DVec3};
 
 use super::kit::tab::{make_tab, tab_defaults, Tab, TabArgs, TabOptions, TAB_DEFAULTS};
-use super::rigid_sheet::{
+use super::rigid::sheet::{
     rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
@@ -1755,7 +1755,7 @@ mod tests {
             max_island_faces,
             flat_fold: 1f64.to_radians(),
             island_spread: ISLAND_SPREAD,
-            rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
+            rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
         }
     }
 

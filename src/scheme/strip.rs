@@ -189,7 +189,7 @@ impl Scheme for Strips {
         };
         Ok(Box::new(StripOptions {
             net: NetOptions {
-                rigid: super::rigid_sheet::RigidSheet::CARD,
+                rigid: super::rigid::sheet::RigidSheet::CARD,
                 panel,
                 tab_height: args.tab.height()?,
                 max_island_faces: None,
