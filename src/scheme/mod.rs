@@ -7,16 +7,13 @@
 //! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
 //! module reaches the schemes only through a [`Registry`].
 
-pub mod edge_panel;
+pub mod edge;
 pub mod ergs;
 pub mod half_edge;
 mod kit;
 pub mod net;
-pub mod quad_edge;
 pub mod rigid;
-pub mod sandwich;
 pub mod strip;
-pub mod winged_edge;
 pub mod woven;
 
 use std::any::Any;
@@ -33,8 +30,8 @@ use crate::record::{round4, Params};
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
 pub static SCHEMES: [&dyn Scheme; 6] = [
     &half_edge::HalfEdge,
-    &quad_edge::QuadEdge,
-    &winged_edge::WingedEdge,
+    &edge::quad::QuadEdge,
+    &edge::winged::WingedEdge,
     &woven::Woven,
     &net::Net,
     &strip::Strips,
