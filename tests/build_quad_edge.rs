@@ -35,8 +35,8 @@ use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use unfold::panel::{Covers, FlatPanel, Fold, Panel};
-use unfold::scheme::edge_panel::EdgeOptions;
-use unfold::scheme::quad_edge::MAX_FLAP_SCALE;
+use unfold::scheme::edge::flaps::EdgeOptions;
+use unfold::scheme::edge::quad::MAX_FLAP_SCALE;
 
 // =======================================================================================
 // Helpers

@@ -7,17 +7,13 @@
 //! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
 //! module reaches the schemes only through a [`Registry`].
 
-pub mod bracket;
-pub mod edge_panel;
+pub mod edge;
 pub mod ergs;
 pub mod half_edge;
+mod kit;
 pub mod net;
-pub mod quad_edge;
 pub mod rigid;
-pub mod rigid_sheet;
-pub mod sandwich;
 pub mod strip;
-pub mod winged_edge;
 pub mod woven;
 
 use std::any::Any;
@@ -34,8 +30,8 @@ use crate::record::{round4, Params};
 /// The built-in schemes, in the order `--help` lists them; the first is the default.
 pub static SCHEMES: [&dyn Scheme; 6] = [
     &half_edge::HalfEdge,
-    &quad_edge::QuadEdge,
-    &winged_edge::WingedEdge,
+    &edge::quad::QuadEdge,
+    &edge::winged::WingedEdge,
     &woven::Woven,
     &net::Net,
     &strip::Strips,
@@ -536,40 +532,6 @@ impl SchemeError {
     pub fn is_usage(&self) -> bool {
         matches!(self, SchemeError::Options(_))
     }
-}
-
-/// `--thickness` as `--help` states its default (the schemes that take it differ).
-pub(super) fn thickness_default() -> crate::option_default::OptionDefault {
-    crate::option_default::OptionDefault::words(
-        "thickness",
-        "0mm for half-edge, net, quad-edge and winged-edge, 0.1in for woven",
-    )
-}
-
-/// A material thickness as given (`text`, else `default`), in mm: zero or more, and
-/// below the usable sheet's shorter side.
-pub(super) fn thickness(
-    long: &str,
-    text: Option<&str>,
-    default: &str,
-    panel: &PanelOptions,
-) -> Result<f64, String> {
-    let text = text.unwrap_or(default);
-    let thickness = crate::units::parse_length(text).map_err(|e| format!("--{long}: {e}"))?;
-    if !(thickness >= 0.0 && thickness.is_finite()) {
-        return Err(format!("--{long}: '{text}' must be zero or positive"));
-    }
-    // Material thicker than the sheet is wide is a typo (1e300mm would also overflow
-    // the geometry).
-    if let Some(limit) = panel.panel_limit {
-        let widest = limit.width.min(limit.height);
-        if thickness >= widest {
-            return Err(format!(
-                "--{long}: '{text}' is not below the usable sheet's shorter side ({widest:.1} mm); it is the material's thickness"
-            ));
-        }
-    }
-    Ok(thickness)
 }
 
 /// The face band of a face: each corner moved toward the face centre,

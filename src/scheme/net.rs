@@ -27,8 +27,8 @@ use std::collections::{BTreeMap, HashMap};
 
 use glam::{DVec2, DVec3};
 
-use super::half_edge::{make_tab, tab_defaults, HalfEdgeOptions, Tab, TabArgs, TAB_DEFAULTS};
-use super::rigid_sheet::{
+use super::kit::tab::{make_tab, tab_defaults, Tab, TabArgs, TabOptions, TAB_DEFAULTS};
+use super::rigid::sheet::{
     rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
 };
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
@@ -714,14 +714,9 @@ struct JoinRules<'a> {
     component_faces: &'a [usize],
 }
 
-/// The options for a half-edge tab of height `height`.
-fn tab_options(options: &NetOptions, height: f64) -> HalfEdgeOptions {
-    HalfEdgeOptions {
-        panel: options.panel.clone(),
-        tabs: true,
-        tab_height: height,
-        rigid: super::rigid_sheet::RigidSheet::CARD,
-    }
+/// The options for a tab of height `height`.
+fn tab_options(options: &NetOptions, height: f64) -> TabOptions {
+    TabOptions::new(&options.panel, height)
 }
 
 /// The map between a tab's 3D plane (the partner face's) and its island's flat frame,
@@ -1729,7 +1724,7 @@ mod tests {
             max_island_faces,
             flat_fold: 1f64.to_radians(),
             island_spread: ISLAND_SPREAD,
-            rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
+            rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
         }
     }
 

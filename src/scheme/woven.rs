@@ -27,6 +27,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::ergs::{trace_cycles, WeaveCycle};
+use super::kit::thickness::{thickness, thickness_default};
 use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use super::{ConnectionName, PanelLimit, Scheme, SchemeError, SchemeOutput};
 use crate::mesh::geometry::{planarity_error, vector_area};
@@ -101,7 +102,7 @@ impl Scheme for Woven {
             &[
                 OptionDefault::value("band-scale", BAND_SCALE),
                 OptionDefault::value("curl-limit", CURL_LIMIT),
-                super::thickness_default(),
+                thickness_default(),
             ],
         )
     }
@@ -143,8 +144,7 @@ impl Scheme for Woven {
                 "--curl-limit: {curl_limit} must be at least 1.5 (a straight strip's hull is about its own area)"
             ));
         }
-        let thickness =
-            super::thickness("thickness", args.thickness.as_deref(), THICKNESS, &panel)?;
+        let thickness = thickness("thickness", args.thickness.as_deref(), THICKNESS, &panel)?;
         Ok(Box::new(WovenOptions {
             panel,
             band_scale,

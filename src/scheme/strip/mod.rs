@@ -38,7 +38,7 @@ use glam::DVec3;
 use crate::mesh::{HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::{round4, Params};
-use crate::scheme::half_edge::{tab_defaults, TabArgs, TAB_DEFAULTS};
+use crate::scheme::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
 use crate::scheme::net::{FlatFoldArgs, NetOptions, FLAT_FOLD_DEG};
 use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use crate::scheme::{Scheme, SchemeError, SchemeOutput};
@@ -194,7 +194,7 @@ impl Scheme for Strips {
         };
         Ok(Box::new(StripOptions {
             net: NetOptions {
-                rigid: crate::scheme::rigid_sheet::RigidSheet::CARD,
+                rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
                 panel,
                 tab_height: args.tab.height()?,
                 max_island_faces: None,

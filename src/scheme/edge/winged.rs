@@ -15,15 +15,16 @@
 
 use glam::DVec2;
 
-use super::edge_panel::{
-    band, band_defaults, corner_half_edges, edge_scheme, place_pins, BandArgs, EdgeOptions,
-    FaceFlaps, WidenFor, EDGE_DEFAULTS,
+use super::flaps::{
+    band, band_defaults, corner_half_edges, place_pins, BandArgs, EdgeOptions, FaceFlaps,
+    EDGE_DEFAULTS,
 };
-use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
-use super::{SchemeError, SchemeOutput};
+use super::panels::{edge_scheme, WidenFor};
 use crate::mesh::{FaceId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::Params;
+use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use crate::scheme::{SchemeError, SchemeOutput};
 
 /// The winged-edge scheme: quad-edge panels with wings along the neighbouring edges.
 pub struct WingedEdge;

@@ -14,23 +14,24 @@
 //! At every face corner (f, v) the flaps of the two edges meeting there overlap; that
 //! overlap is the connection between the two panels, and its fastener holes are placed
 //! once, in f's plane, so both panels carry them at the same 3D points. A boundary edge's
-//! panel is its one flap. The bend and the panel assembly live in
-//! [`super::edge_panel`], shared with the winged-edge scheme.
+//! panel is its one flap. The bend and the panel assembly live in [`super::flaps`] and
+//! [`super::panels`], shared with the winged-edge scheme.
 
 use glam::DVec2;
 
-use super::edge_panel::{
-    band, band_defaults, corner_half_edges, edge_scheme, notch_flap, place_pins, BandArgs,
-    EdgeOptions, FaceFlaps, WidenFor, EDGE_DEFAULTS,
+use super::flaps::{
+    band, band_defaults, corner_half_edges, notch_flap, place_pins, BandArgs, EdgeOptions,
+    FaceFlaps, EDGE_DEFAULTS,
 };
-use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
-use super::{SchemeError, SchemeOutput};
+use super::panels::{edge_scheme, WidenFor};
 use crate::mesh::{FaceId, Mesh};
 use crate::option_default::state_defaults;
 use crate::plane::{clip_half_plane, contains, distance_to_border};
 use crate::record::Params;
+use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use crate::scheme::{SchemeError, SchemeOutput};
 
-pub use super::edge_panel::panel_id;
+pub use super::flaps::panel_id;
 
 /// The quad-edge scheme: one panel per edge, joined at face corners.
 pub struct QuadEdge;

@@ -29,13 +29,13 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 use rayon::prelude::*;
 
-use super::edge_panel::{
+use super::flaps::{
     bend_id_label, bezier, corners_of, flap_labels, EdgeOptions, FaceFlaps, FaceFrame,
 };
-use super::SchemeError;
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Covers, Hole, IdKind, Label, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, signed_area};
+use crate::scheme::SchemeError;
 use crate::units::fmt_num;
 
 /// The outer layer of an edge panel: `E12`, on the model's surface.

@@ -7,7 +7,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::rigid::{
+use super::cutback::{
     interior_angle, outline_prisms, overlap, Prism, RigidOutline, OVERLAP_TOLERANCE,
 };
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
@@ -586,10 +586,10 @@ pub fn clear_brackets(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::rigid::rigid_panels;
+    use crate::scheme::rigid::cutback::rigid_panels;
 
     fn cube() -> Mesh {
-        crate::scheme::rigid::cube(200.0)
+        crate::scheme::rigid::cutback::cube(200.0)
     }
 
     #[test]

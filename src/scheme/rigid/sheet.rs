@@ -1,18 +1,19 @@
 //! Rigid sheet as a scheme's output, for the schemes whose panels can be flat parts
 //! (half-edge: one per face; net: one per flat region): the options, the panels cut
-//! back by [`super::rigid`] and held by [`super::bracket`]s, their labels, the report
+//! back by [`super::cutback`] and held by [`super::bracket`]s, their labels, the report
 //! and the refusal of a thickness the model cannot take.
 
 use glam::DVec3;
 
 use super::bracket::{bracket_panel, clear_brackets, slotted_facets, BracketSizes, Slot};
-use super::half_edge::outline_labels;
-use super::rigid::{rigid_panels, thickest, RigidError};
-use super::{PanelOptions, SchemeError, SchemeOutput};
+use super::cutback::{rigid_panels, thickest, RigidError};
 use crate::mesh::{FaceId, Mesh};
 use crate::option_default::OptionDefault;
 use crate::panel::{Name, Panel, Panels, Source};
 use crate::record::{round4, Params};
+use crate::scheme::kit::labels::outline_labels;
+use crate::scheme::kit::thickness::{thickness, thickness_default};
+use crate::scheme::{PanelOptions, SchemeError, SchemeOutput};
 use crate::units::fmt_num;
 
 /// Connector kinds.
@@ -34,7 +35,7 @@ const SLOT_CLEARANCE: &str = "0.1mm";
 
 /// The rigid sheet options (half-edge, net), as given.
 #[derive(Clone, Debug, Default, clap::Args)]
-pub(super) struct RigidArgs {
+pub(in crate::scheme) struct RigidArgs {
     /// Connectors on interior edges: tab, bracket (rigid sheet) or none.
     #[arg(long, value_name = "KIND")]
     connectors: Option<Connectors>,
@@ -52,10 +53,10 @@ pub(super) struct RigidArgs {
 
 /// The defaults of the rigid sheet options, for the `options()` of the schemes that
 /// take them.
-pub(super) fn rigid_defaults() -> [OptionDefault; 3] {
+pub(in crate::scheme) fn rigid_defaults() -> [OptionDefault; 3] {
     [
         OptionDefault::words("connectors", CONNECTORS_WORDS),
-        super::thickness_default(),
+        thickness_default(),
         OptionDefault::value("slot-clearance", SLOT_CLEARANCE),
     ]
 }
@@ -73,8 +74,8 @@ pub struct RigidSheet {
 
 impl RigidArgs {
     /// The options, checked: tabs only in card, brackets only in rigid sheet.
-    pub(super) fn resolve(&self, panel: &PanelOptions) -> Result<RigidSheet, String> {
-        let thickness = super::thickness("thickness", self.thickness.as_deref(), "0mm", panel)?;
+    pub(in crate::scheme) fn resolve(&self, panel: &PanelOptions) -> Result<RigidSheet, String> {
+        let thickness = thickness("thickness", self.thickness.as_deref(), "0mm", panel)?;
         let connectors = match (self.connectors, thickness > 0.0) {
             (Some(Connectors::Tab), true) => {
                 return Err("--connectors tab: tabs cannot fold in rigid sheet (--thickness above zero); give --connectors bracket or none".to_string())
@@ -115,7 +116,7 @@ impl RigidSheet {
     };
 
     /// `--connectors` as the manifest records it.
-    pub(super) fn connectors_name(&self) -> &'static str {
+    pub(in crate::scheme) fn connectors_name(&self) -> &'static str {
         match self.connectors {
             Connectors::Tab => "tab",
             Connectors::Bracket => "bracket",
@@ -125,7 +126,7 @@ impl RigidSheet {
 
     /// The thickness and, with brackets, the slot clearance, as the manifest records
     /// them.
-    pub(super) fn sheet_params(&self, params: &mut Params) {
+    pub(in crate::scheme) fn sheet_params(&self, params: &mut Params) {
         params.push("thickness", round4(self.thickness));
         if let Some(sizes) = self.brackets {
             params.push("slot_clearance", round4(sizes.clearance));
@@ -134,7 +135,7 @@ impl RigidSheet {
 }
 
 /// What the panels of a rigid build's faces are called and where their ids go.
-pub(super) struct PanelNames {
+pub(in crate::scheme) struct PanelNames {
     /// Each face's panel.
     pub sources: Vec<Source>,
     /// Where each face's panel id goes (a point inside the face), or `None` for the
@@ -148,7 +149,7 @@ pub(super) struct PanelNames {
 
 impl PanelNames {
     /// A panel per face, `F<f>` at its centre; edges as they are.
-    pub(super) fn of_faces(mesh: &Mesh) -> PanelNames {
+    pub(in crate::scheme) fn of_faces(mesh: &Mesh) -> PanelNames {
         PanelNames {
             sources: mesh.faces().map(|f| Source::face(f.0)).collect(),
             anchors: vec![None; mesh.face_count()],
@@ -165,7 +166,7 @@ impl PanelNames {
 /// The panels of `mesh`'s faces in rigid sheet, kept inside `surface` (the model's
 /// own faces): each face's outline cut back so that no two panels pass through each
 /// other, meeting edge to edge, with brackets if asked.
-pub(super) fn rigid_output(
+pub(in crate::scheme) fn rigid_output(
     mesh: &Mesh,
     surface: &Mesh,
     sheet: &RigidSheet,
