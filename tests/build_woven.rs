@@ -20,7 +20,8 @@ use common::build::{
     model, options, pipeline, resolve, DxfCheck,
 };
 use unfold::mesh::geometry::vector_area;
-use unfold::scheme::woven::{ribbons, PieceKind, WovenOptions};
+use unfold::scheme::woven::options::WovenOptions;
+use unfold::scheme::woven::ribbon::{ribbons, PieceKind};
 
 /// Model, number of cycles, edges per cycle (all equal here).
 const WEAVES: [(&str, usize, usize); 7] = [

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use glam::DVec3;
 use unfold::mesh::{build_from_faces, prepare, read_model, Mesh, PrepareOptions};
-use unfold::scheme::ergs::{trace_cycles, Side, WeaveCycle};
+use unfold::scheme::woven::ergs::{trace_cycles, Side, WeaveCycle};
 
 fn model(name: &str) -> Mesh {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))

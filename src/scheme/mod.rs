@@ -1,14 +1,16 @@
 //! Panel schemes: each takes a read-only mesh (in millimetres) and its options and
 //! returns 3D panels with provenance. A scheme knows nothing of sheets or files.
 //!
-//! A scheme is one file here: a type implementing [`Scheme`] (its name, help, its own
-//! command-line and config options with their defaults and checks, whether it needs
-//! convex faces) and the [`Configured`] value it resolves to (the build, and what it
-//! adds to the manifest and the report). [`SCHEMES`] lists them; everything above this
-//! module reaches the schemes only through a [`Registry`].
+//! A scheme is one file here or in its family's folder (`edge/`, `woven/`): a type
+//! implementing [`Scheme`] (its name, help, its own command-line and config options
+//! with their defaults and checks, whether it needs convex faces) and the
+//! [`Configured`] value it resolves to (the build, and what it adds to the manifest
+//! and the report). [`SCHEMES`] lists them; everything above this module reaches the
+//! schemes only through a [`Registry`]. What several schemes share is in `kit/` or in
+//! their family's folder; `rigid/` holds the rigid sheet output of the schemes that
+//! take it.
 
 pub mod edge;
-pub mod ergs;
 pub mod half_edge;
 mod kit;
 pub mod net;
