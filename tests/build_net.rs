@@ -16,7 +16,7 @@ use tempfile::TempDir;
 use common::build::*;
 use unfold::mesh::Mesh;
 use unfold::panel::Covers;
-use unfold::scheme::net::{ISLAND, MATCH};
+use unfold::scheme::island::{ISLAND, MATCH};
 
 /// Interior edges of a mesh (edges with a face on both sides).
 fn interior_edges(mesh: &Mesh) -> usize {

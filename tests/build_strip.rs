@@ -16,7 +16,7 @@ use tempfile::TempDir;
 
 use common::build::*;
 use unfold::mesh::{FaceId, Mesh};
-use unfold::scheme::net::MATCH;
+use unfold::scheme::island::MATCH;
 
 /// An OBJ of `points` and `faces` (0-based), written to `dir/name.obj`.
 fn write_model(dir: &Path, name: &str, points: &[DVec3], faces: &[Vec<u32>]) -> PathBuf {

@@ -12,6 +12,7 @@
 
 pub mod edge;
 pub mod half_edge;
+pub mod island;
 mod kit;
 pub mod net;
 pub mod registry;

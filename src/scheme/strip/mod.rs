@@ -13,7 +13,7 @@
 //! of a ring (an ear) does not narrow the strips round the rest (`strips_ridged`).
 //! Where a sector meets one split differently, each point of one on the other's edge
 //! becomes a corner of both. The strips are welded into one surface where they share
-//! their curves' points; the net scheme's islands then grow along each strip's rungs
+//! their curves' points; the island engine's islands then grow along each strip's rungs
 //! in order, so a piece is a run of its strip, as long as keeps it clear of itself
 //! and on the sheet, and every curve between strips (and the rung between two
 //! pieces) gets a tab with match numbers.
@@ -38,8 +38,8 @@ use glam::DVec3;
 use crate::mesh::{HalfedgeId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::{round4, Params};
+use crate::scheme::island::{FlatFoldArgs, IslandOptions, FLAT_FOLD_DEG};
 use crate::scheme::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
-use crate::scheme::net::{FlatFoldArgs, NetOptions, FLAT_FOLD_DEG};
 use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
 use crate::scheme::{Scheme, SchemeError, SchemeOutput};
 use cover::STAYS_OFF;
@@ -137,8 +137,8 @@ impl std::fmt::Display for Deviation {
 /// The strip scheme's options, resolved (lengths in mm).
 #[derive(Clone, Debug, PartialEq)]
 struct StripOptions {
-    /// The tabs, the sheet and the folds, as the net scheme takes them.
-    net: NetOptions,
+    /// The tabs, the sheet and the folds, as the island engine takes them.
+    islands: IslandOptions,
     /// `--max-deviation`.
     max_deviation: Deviation,
 }
@@ -193,8 +193,7 @@ impl Scheme for Strips {
             None => Deviation::Fraction(MAX_DEVIATION_PERCENT / 100.0),
         };
         Ok(Box::new(StripOptions {
-            net: NetOptions {
-                rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
+            islands: IslandOptions {
                 panel,
                 tab_height: args.tab.height()?,
                 max_island_faces: None,
@@ -208,7 +207,7 @@ impl Scheme for Strips {
 
 impl Configured for StripOptions {
     fn panel(&self) -> &PanelOptions {
-        &self.net.panel
+        &self.islands.panel
     }
 
     fn build(&self, mesh: &Mesh) -> Result<SchemeOutput, SchemeError> {
@@ -229,8 +228,8 @@ impl Configured for StripOptions {
 
     fn params(&self) -> Params {
         let mut params = Params::default();
-        params.push("tab_height", round4(self.net.tab_height));
-        params.push("flat_fold_deg", round4(self.net.flat_fold.to_degrees()));
+        params.push("tab_height", round4(self.islands.tab_height));
+        params.push("flat_fold_deg", round4(self.islands.flat_fold.to_degrees()));
         match self.max_deviation {
             Deviation::Length(mm) => params.push("max_deviation", round4(mm)),
             fraction => params.push("max_deviation", fraction.to_string()),
@@ -239,7 +238,7 @@ impl Configured for StripOptions {
     }
 
     fn least_scored_fold(&self) -> f64 {
-        self.net.flat_fold
+        self.islands.flat_fold
     }
 
     fn panels_follow_faces(&self) -> bool {
@@ -280,7 +279,7 @@ fn strip_panels(
     let (lo, hi) = crate::mesh::geometry::bounding_box(mesh.positions().iter().copied());
     let bound = options.max_deviation.length((hi - lo).length());
     let surface = Triangles::from_mesh(mesh);
-    let limit = options.net.panel.panel_limit;
+    let limit = options.islands.panel.panel_limit;
     // Bands are cut across into sectors about as long as the sheet's shorter side: an
     // unrolled sector is an arc, and shorter arcs nest closer (docs/benchmarks.md).
     let sector_length = limit.map_or(f64::INFINITY, |l| l.width.min(l.height));
@@ -319,7 +318,7 @@ fn strip_panels(
         let strip = |h: HalfedgeId| welded.mesh.face(h).map(|f| welded.strip_of_face[f.index()]);
         strip(h) <= strip(h.twin())
     };
-    let (net, members) = clear_pieces(&welded, &options.net, piece_length, &tab_first);
+    let (net, members) = clear_pieces(&welded, &options.islands, piece_length, &tab_first);
     let joined = welded.joined(&members);
     let mut output = net.output;
     let pieces = output.panels.len();

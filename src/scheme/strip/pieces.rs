@@ -1,6 +1,6 @@
-//! The pieces cut from the welded strips: the net scheme's islands grown along each
-//! strip's rungs, cut again where a piece meets itself, and joined where one has no
-//! room for its id.
+//! The pieces cut from the welded strips: the island engine's islands grown along
+//! each strip's rungs, cut again where a piece meets itself, and joined where one has
+//! no room for its id.
 
 use std::collections::BTreeMap;
 
@@ -8,7 +8,7 @@ use rayon::prelude::*;
 
 use super::welded::{shared_edge, Welded};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
-use crate::scheme::net::{islands_along, IslandNames, IslandNet, NetOptions, OwnNet};
+use crate::scheme::island::{islands_along, IslandNames, IslandNet, IslandOptions, OwnNet};
 use crate::scheme::SchemeOutput;
 
 /// The pieces: islands grown along the strips' rungs, in order, each strip longer than
@@ -22,7 +22,7 @@ use crate::scheme::SchemeOutput;
 /// piece's faces, in the order of its panels.
 pub(super) fn clear_pieces(
     welded: &Welded,
-    options: &NetOptions,
+    options: &IslandOptions,
     piece_length: f64,
     tab_first: &dyn Fn(HalfedgeId) -> bool,
 ) -> (IslandNet, Vec<Vec<u32>>) {
