@@ -16,7 +16,8 @@
 use jagua_rs::geometry::primitives::{Point, SPolygon};
 use rayon::prelude::*;
 
-use super::{Candidate, Nester, Part, EDGE_GAP, MIN_STEP};
+use super::nester::{Candidate, Nester, EDGE_GAP, MIN_STEP};
+use super::part::Part;
 
 /// Parts, next in height order, that compete for each place in a row.
 const ROW_CANDIDATES: usize = 12;
@@ -275,7 +276,9 @@ fn flat_orientations(p: &Part) -> Vec<usize> {
 mod tests {
     use glam::DVec2;
 
-    use super::super::{prepare, NestOptions, Nester};
+    use super::super::nester::Nester;
+    use super::super::options::NestOptions;
+    use super::super::part::prepare;
     use crate::nest::SheetSpec;
 
     /// Sheets the construction in rows alone (no improvement) takes for `n` copies of

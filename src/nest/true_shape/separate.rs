@@ -12,38 +12,17 @@
 //! to a constructive check, as measured on the bunny and the knight. On sheets holding
 //! hundreds of parts (horse_quad quad-edge) an evaluation costs about twice what it
 //! counts.
-//!
-//! Overlap between two parts is measured on discs inside their collision shapes (the
-//! engine's poles and a lattice of inscribed discs), as sparrow does: for every pair of
-//! discs, the penetration depth times the smaller radius, where a depth below a small
-//! epsilon (1 % of the larger part's diameter) decays smoothly instead of dropping to
-//! zero, so that two discs about to touch still count a little. The loss of a pair of
-//! parts is the square root of π times that sum plus epsilon squared (so every
-//! collision costs something, tab tips included), times the geometric mean of the
-//! square roots of their convex hulls' areas (large parts left overlapping cost more).
 
 use rayon::prelude::*;
 use std::collections::{BTreeMap, HashMap};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
-use jagua_rs::collision_detection::hazards::collector::BasicHazardCollector;
 use jagua_rs::collision_detection::hazards::filter::NoFilter;
 use jagua_rs::collision_detection::hazards::{BasicHazardEntity, PItemKey};
-use jagua_rs::geometry::geo_traits::{CollidesWith, DistanceTo, Transformable, TransformableFrom};
-use jagua_rs::geometry::primitives::{Circle, Point, SPolygon};
-use jagua_rs::geometry::{DTransformation, Transformation};
+use jagua_rs::geometry::geo_traits::TransformableFrom;
 
-use super::{Candidate, Nester, Part, MIN_STEP};
-
-/// Most lattice points of a part's bounds tried as disc centres.
-const LATTICE_POINTS: usize = 400;
-
-/// Discs kept per part (the largest).
-const MAX_DISCS: usize = 32;
-
-/// Epsilon of the overlap measure, as a share of the larger part's diameter.
-const EPSILON_SHARE: f32 = 0.01;
+use super::nester::{Candidate, Nester, MIN_STEP};
 
 /// Cost of a pose outside the sheet (never chosen while any other pose exists).
 const OUTSIDE: f32 = 1e12;
@@ -82,84 +61,6 @@ const DISC_PAIRS_PER_CHECK: usize = 128;
 /// Sampled poses per move, before the local descent.
 const MOVE_SAMPLES: usize = 48;
 
-/// Inscribed discs of a collision shape (in its own frame), largest first: the
-/// engine's poles, then lattice points by decreasing clearance, each kept when no
-/// kept disc holds its centre, so that long thin parts are covered end to end.
-pub(super) fn overlap_discs(shape: &SPolygon) -> Vec<Circle> {
-    let bb = shape.bbox();
-    // A quarter of the shorter side, coarser where that would pass the point limit.
-    let step = (0.25 * bb.width().min(bb.height()))
-        .max((bb.width() * bb.height() / LATTICE_POINTS as f32).sqrt());
-    let (cols, rows) = (
-        (bb.width() / step).ceil().max(1.0) as usize,
-        (bb.height() / step).ceil().max(1.0) as usize,
-    );
-    let mut candidates: Vec<Circle> = Vec::new();
-    for i in 0..cols {
-        for j in 0..rows {
-            let p = Point(
-                bb.x_min + (i as f32 + 0.5) / cols as f32 * bb.width(),
-                bb.y_min + (j as f32 + 0.5) / rows as f32 * bb.height(),
-            );
-            if !shape.collides_with(&p) {
-                continue;
-            }
-            let radius = shape
-                .edge_iter()
-                .map(|e| e.distance_to(&p))
-                .fold(f32::INFINITY, f32::min);
-            if radius > 0.0 {
-                candidates.push(Circle { center: p, radius });
-            }
-        }
-    }
-    candidates.sort_by(|a, b| b.radius.total_cmp(&a.radius));
-    let mut discs: Vec<Circle> = shape.surrogate().poles.clone();
-    for c in candidates {
-        if discs.len() >= MAX_DISCS {
-            break;
-        }
-        if discs
-            .iter()
-            .all(|d| d.center.distance_to(&c.center) >= d.radius)
-        {
-            discs.push(c);
-        }
-    }
-    discs.sort_by(|a, b| b.radius.total_cmp(&a.radius));
-    discs
-}
-
-/// Facts of a part that its overlap loss uses besides its discs.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct LossScale {
-    /// Largest distance across the collision shape (mm).
-    pub diameter: f32,
-    /// Square root of the area of its convex hull (mm).
-    pub hull_root: f32,
-}
-
-/// Overlap loss of two posed parts (their discs and scales): see the module
-/// documentation. Every pair of discs counts, however far apart: the decayed terms of
-/// discs that are close but apart are what tells two parts that only touch at their
-/// outlines how to move apart.
-fn pair_loss(a: &[Circle], b: &[Circle], sa: LossScale, sb: LossScale) -> f32 {
-    let eps = EPSILON_SHARE * sa.diameter.max(sb.diameter);
-    let mut total = 0.0;
-    for p in a {
-        for q in b {
-            let depth = p.radius + q.radius - p.center.distance_to(&q.center);
-            let decayed = if depth >= eps {
-                depth
-            } else {
-                eps * eps / (2.0 * eps - depth)
-            };
-            total += decayed * p.radius.min(q.radius);
-        }
-    }
-    (std::f32::consts::PI * total + eps * eps).sqrt() * (sa.hull_root * sb.hull_root).sqrt()
-}
-
 /// Overlapping pairs of parts on a sheet (by part index, smaller first) and their
 /// overlap.
 type Pairs = BTreeMap<(usize, usize), f32>;
@@ -172,52 +73,6 @@ impl Weights {
     fn get(&self, a: usize, b: usize) -> f32 {
         self.0.get(&(a.min(b), a.max(b))).copied().unwrap_or(1.0)
     }
-}
-
-/// Buffers of the overlap measure.
-#[derive(Default)]
-pub(super) struct OverlapScratch {
-    collector: BasicHazardCollector,
-    discs: PosedDiscs,
-}
-
-/// The discs of the part being evaluated and of one it collides with, posed.
-#[derive(Default)]
-struct PosedDiscs {
-    mine: Vec<Circle>,
-    theirs: Vec<Circle>,
-}
-
-impl PosedDiscs {
-    /// Poses the discs of `part` (the one evaluated) by `transform`.
-    fn pose_mine(&mut self, parts: &[Part], part: usize, transform: &Transformation) {
-        pose_discs(&parts[part].discs, transform, &mut self.mine);
-    }
-
-    /// Overlap loss of `part`, whose discs [`PosedDiscs::pose_mine`] posed, with
-    /// `other` placed at `placed`; adds the disc pairs weighed to `disc_pairs`.
-    fn loss_with(
-        &mut self,
-        parts: &[Part],
-        part: usize,
-        other: usize,
-        placed: &DTransformation,
-        disc_pairs: &mut usize,
-    ) -> f32 {
-        pose_discs(&parts[other].discs, &placed.compose(), &mut self.theirs);
-        *disc_pairs += self.mine.len() * self.theirs.len();
-        pair_loss(
-            &self.mine,
-            &self.theirs,
-            parts[part].scale,
-            parts[other].scale,
-        )
-    }
-}
-
-fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle>) {
-    out.clear();
-    out.extend(discs.iter().map(|d| d.transform_clone(transform)));
 }
 
 impl Nester<'_> {
@@ -676,8 +531,10 @@ impl Nester<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::super::test_rectangle as rectangle;
-    use super::super::{prepare, NestOptions, Nester, SheetSpec};
+    use super::super::options::NestOptions;
+    use super::super::part::prepare;
     use super::*;
+    use crate::nest::SheetSpec;
 
     fn options() -> NestOptions {
         NestOptions {
@@ -688,77 +545,6 @@ mod tests {
             time_limit: None,
         }
     }
-
-    #[test]
-    fn discs_lie_inside_and_cover_a_long_thin_part() {
-        let sheet = SheetSpec {
-            width: 400.0,
-            height: 400.0,
-            margin: 0.0,
-            spacing: 0.0,
-        };
-        let (parts, _) = prepare(&[rectangle(150.0, 10.0)], sheet, &options()).unwrap();
-        let shape = parts[0].item.shape_cd();
-        let discs = &parts[0].discs;
-        assert!(discs.len() >= 10, "{} discs", discs.len());
-        for d in discs {
-            assert!(shape.collides_with(&d.center));
-            let clearance = shape
-                .edge_iter()
-                .map(|e| e.distance_to(&d.center))
-                .fold(f32::INFINITY, f32::min);
-            assert!(d.radius <= clearance + 1e-3, "{d:?} sticks out");
-        }
-        // Every point of the centre line, but the ends, is within 0.5 mm of a disc.
-        for i in 0..=26 {
-            let p = Point(-65.0 + 5.0 * i as f32, 0.0);
-            assert!(
-                discs
-                    .iter()
-                    .any(|d| d.center.distance_to(&p) <= d.radius + 0.5),
-                "{p:?} is not covered"
-            );
-        }
-    }
-
-    #[test]
-    fn overlap_shrinks_as_parts_move_apart() {
-        let square = |x: f32| -> Vec<Circle> {
-            let mut discs = vec![Circle {
-                center: Point(x, 0.0),
-                radius: 10.0,
-            }];
-            for (dx, dy) in [(-6.0, -6.0), (6.0, -6.0), (6.0, 6.0), (-6.0, 6.0)] {
-                discs.push(Circle {
-                    center: Point(x + dx, dy),
-                    radius: 4.0,
-                });
-            }
-            discs
-        };
-        let scale = LossScale {
-            diameter: 28.0,
-            hull_root: 20.0,
-        };
-        let a = square(0.0);
-        let mut last = f32::INFINITY;
-        // Overlapping, then apart: the loss keeps shrinking, so a part that only
-        // touches its neighbour still knows which way is out.
-        for step in 0..30 {
-            let loss = pair_loss(&a, &square(2.0 * step as f32), scale, scale);
-            assert!(loss < last, "not shrinking at step {step}: {loss}");
-            last = loss;
-        }
-        // Never below the floor of epsilon (0.28 mm) times the hull factor.
-        assert!(last > 0.28 * 20.0, "{last}");
-        // Symmetric, so a pair's overlap does not depend on which part was moved.
-        let b = square(7.0);
-        assert_eq!(
-            pair_loss(&a, &b, scale, scale),
-            pair_loss(&b, &a, scale, scale)
-        );
-    }
-
     /// Eight 80 mm squares on a 300 mm sheet, the middle row of two placed so that
     /// no 80 mm square is free; the ninth is alone on a second sheet. Squeezing it
     /// into the first needs the middle row rearranged.
