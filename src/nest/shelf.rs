@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 
-use super::{Layout, Placement, SheetSpec, TooLarge};
+use super::layout::{Layout, Placement, SheetSpec, TooLarge};
 use crate::plane::{orient, Oriented};
 
 /// Lays out parts (outer outlines in mm). Deterministic: ties break by part index.

@@ -39,7 +39,7 @@ mod part;
 mod rows;
 mod separate;
 
-use super::{Layout, NestProgress, SheetSpec, TooLarge};
+use crate::nest::layout::{Layout, NestProgress, SheetSpec, TooLarge};
 use nester::Nester;
 pub use options::NestOptions;
 use part::{prepare, too_large};

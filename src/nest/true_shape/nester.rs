@@ -18,7 +18,7 @@ use rayon::prelude::*;
 use super::options::NestOptions;
 use super::part::{OverlapScratch, Part};
 use crate::nest::grid::Grid;
-use crate::nest::{Layout, NestProgress, Placement, SheetSpec};
+use crate::nest::layout::{Layout, NestProgress, Placement, SheetSpec};
 use crate::rng::SplitMix64;
 
 /// Weight of the x coordinate in the bottom-left score (y counts 1): with the contact

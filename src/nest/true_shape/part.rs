@@ -26,7 +26,7 @@ use jagua_rs::geometry::{AllowedOrientations, DTransformation, OriginalShape, Tr
 use rayon::prelude::*;
 
 use super::options::NestOptions;
-use crate::nest::{SheetSpec, TooLarge};
+use crate::nest::layout::{SheetSpec, TooLarge};
 use crate::plane::{bounds, convex_hull, grown_outline, is_clear};
 
 /// Extra inflation (mm) on top of half the spacing: covers the f32 arithmetic of the
