@@ -35,7 +35,8 @@ use common::svg_circles;
 use unfold::config::{BuildOptions, Job};
 use unfold::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use unfold::panel::{Covers, FlatPanel, Fold, Panel};
-use unfold::scheme::edge::flaps::EdgeOptions;
+use unfold::record::Field;
+use unfold::scheme::edge::flaps::{BandArgs, EdgeOptions};
 use unfold::scheme::edge::quad::MAX_FLAP_SCALE;
 
 // =======================================================================================
@@ -70,11 +71,28 @@ fn quad_job(
     resolve(options, model)
 }
 
-/// The quad-edge job's own options.
-fn edge_options(job: &Job) -> &EdgeOptions {
-    job.scheme
-        .options_as::<EdgeOptions>()
-        .expect("quad-edge options")
+/// The quad-edge job's own options, resolved again from what the job records of them
+/// (the manifest's `scheme.params`).
+fn edge_options(job: &Job) -> EdgeOptions {
+    let params = job.scheme.options.params();
+    let number = |key: &str| {
+        params
+            .0
+            .iter()
+            .find(|(k, _)| k == key)
+            .and_then(|(_, f)| match f {
+                Field::Value(v) => v.as_f64(),
+                Field::Records(_) => None,
+            })
+    };
+    BandArgs {
+        bridge_scale: number("bridge_scale"),
+        flap_scale: number("flap_scale"),
+        samples: number("samples").map(|n| n as u32),
+        ..BandArgs::default()
+    }
+    .resolve(job.scheme.panel().clone())
+    .expect("quad-edge options")
 }
 
 /// Σ face degrees of a mesh (its face corners).
@@ -354,7 +372,7 @@ fn holes_by_face(p: &Pipeline) -> BTreeMap<FaceId, Vec<(DVec3, [EdgeId; 2])>> {
 /// round it where they grow past it; returns the holes checked.
 fn check_foreign_flaps(p: &Pipeline, job: &Job, what: &str, size_mm: f64) -> usize {
     let mesh = &p.mesh;
-    let o = edge_options(job);
+    let o = &edge_options(job);
     let clear = 0.5 * o.panel.hole_diameter + o.panel.hole_margin;
     let tol = 1e-9 * size_mm;
     let holes = holes_by_face(p);
@@ -420,7 +438,7 @@ fn check_foreign_flaps(p: &Pipeline, job: &Job, what: &str, size_mm: f64) -> usi
 /// boundary-edge panel is one flap on its face's band edge.
 fn check_bends(p: &Pipeline, job: &Job, what: &str, size_mm: f64, planar: bool) {
     let mesh = &p.mesh;
-    let o = edge_options(job);
+    let o = &edge_options(job);
     let n = o.samples as usize;
     let tol = 1e-9 * size_mm;
     // Bends are exact between planar faces. Between faces planar only within
@@ -682,7 +700,7 @@ fn check_holes(
     all: bool,
 ) -> HoleFacts {
     let mesh = &p.mesh;
-    let o = edge_options(job);
+    let o = &edge_options(job);
     let wanted = o.panel.holes as usize;
     let d = o.panel.hole_diameter;
     let r = 0.5 * d;

@@ -22,6 +22,7 @@ use common::build::{
 use unfold::mesh::geometry::vector_area;
 use unfold::scheme::woven::options::WovenOptions;
 use unfold::scheme::woven::ribbon::{ribbons, PieceKind};
+use unfold::scheme::OptionValues;
 
 /// Model, number of cycles, edges per cycle (all equal here).
 const WEAVES: [(&str, usize, usize); 7] = [
@@ -79,9 +80,8 @@ fn strands_cross_the_thickness_apart_and_alternate() {
     for (name, _, _) in WEAVES {
         let job = woven_job(name, "200mm", tmp.path());
         let p = pipeline(&job);
-        let woven = job
-            .scheme
-            .options_as::<WovenOptions>()
+        // The job takes the woven defaults.
+        let woven = &WovenOptions::resolve(&OptionValues::default(), job.scheme.panel().clone())
             .expect("woven options");
         let r = woven.thickness;
         assert!((r - 2.54).abs() < 1e-12, "default thickness 0.1 in");

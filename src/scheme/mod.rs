@@ -20,7 +20,6 @@ pub mod rigid;
 pub mod strip;
 pub mod woven;
 
-use std::any::Any;
 use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
@@ -61,7 +60,7 @@ pub trait Scheme: Send + Sync {
 }
 
 /// A scheme with its options resolved, ready to build panels.
-pub trait Configured: fmt::Debug + Send + Sync + AsAny {
+pub trait Configured: fmt::Debug + Send + Sync {
     /// The options every scheme takes, as resolved.
     fn panel(&self) -> &PanelOptions;
     /// Builds the panels of `mesh` (millimetres, faces as the scheme needs them).
@@ -120,19 +119,6 @@ pub trait Configured: fmt::Debug + Send + Sync + AsAny {
         _unsimplified: &[[DVec3; 3]],
     ) -> Result<SchemeOutput, SchemeError> {
         self.build(mesh)
-    }
-}
-
-/// The concrete options behind a [`Configured`], for callers that know their type
-/// (tests, benches); every type has it, so a scheme writes nothing for it.
-pub trait AsAny {
-    /// `self` as [`Any`].
-    fn as_any(&self) -> &dyn Any;
-}
-
-impl<T: Any> AsAny for T {
-    fn as_any(&self) -> &dyn Any {
-        self
     }
 }
 
@@ -284,12 +270,6 @@ impl ConfiguredScheme {
     /// The options every scheme takes.
     pub fn panel(&self) -> &PanelOptions {
         self.options.panel()
-    }
-
-    /// The scheme's own options, when they are a `T`.
-    pub fn options_as<T: 'static>(&self) -> Option<&T> {
-        // Through the trait object: the `Arc` itself is `Any` too.
-        AsAny::as_any(&*self.options).downcast_ref::<T>()
     }
 
     /// Refuses a mesh the scheme can never build ([`Configured::accepts`]).

@@ -107,40 +107,45 @@ impl Scheme for Net {
         values: &OptionValues,
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
-        let args: NetArgs = values.parse()?;
-        if panel.face_scale != 1.0 {
-            return Err(format!(
-                "--face-scale: the net scheme keeps its faces whole (1), not {}; leave it out",
-                panel.face_scale
-            ));
-        }
-        if args.max_island_faces == Some(0) {
-            return Err("--max-island-faces: an island holds at least 1 face".into());
-        }
-        let island_spread = args.island_spread.unwrap_or(ISLAND_SPREAD);
-        if !(island_spread >= 1.0 && island_spread.is_finite()) {
-            return Err(format!(
-                "--island-spread: {island_spread} must be a number of at least 1 (a convex island has 1)"
-            ));
-        }
-        let rigid = args.rigid.resolve(&panel)?;
-        if rigid.connectors == Connectors::None && rigid.thickness == 0.0 {
-            return Err("--connectors none: the net scheme glues its cuts with tabs in card; none is for rigid sheet (--thickness)".into());
-        }
-        if rigid.thickness > 0.0 && args.island_spread.is_some() {
-            return Err("--island-spread: in rigid sheet (--thickness) nothing folds, so each island is a flat region of the model, whatever its shape; leave --island-spread out".into());
-        }
-        Ok(Box::new(NetOptions {
-            islands: IslandOptions {
-                island_spread,
-                panel,
-                tab_height: args.tab.height()?,
-                max_island_faces: args.max_island_faces,
-                flat_fold: args.flat_fold.angle()?,
-            },
-            rigid,
-        }))
+        Ok(Box::new(resolve(values, panel)?))
     }
+}
+
+/// Checks the net options' `values` and fills in their defaults.
+fn resolve(values: &OptionValues, panel: PanelOptions) -> Result<NetOptions, String> {
+    let args: NetArgs = values.parse()?;
+    if panel.face_scale != 1.0 {
+        return Err(format!(
+            "--face-scale: the net scheme keeps its faces whole (1), not {}; leave it out",
+            panel.face_scale
+        ));
+    }
+    if args.max_island_faces == Some(0) {
+        return Err("--max-island-faces: an island holds at least 1 face".into());
+    }
+    let island_spread = args.island_spread.unwrap_or(ISLAND_SPREAD);
+    if !(island_spread >= 1.0 && island_spread.is_finite()) {
+        return Err(format!(
+            "--island-spread: {island_spread} must be a number of at least 1 (a convex island has 1)"
+        ));
+    }
+    let rigid = args.rigid.resolve(&panel)?;
+    if rigid.connectors == Connectors::None && rigid.thickness == 0.0 {
+        return Err("--connectors none: the net scheme glues its cuts with tabs in card; none is for rigid sheet (--thickness)".into());
+    }
+    if rigid.thickness > 0.0 && args.island_spread.is_some() {
+        return Err("--island-spread: in rigid sheet (--thickness) nothing folds, so each island is a flat region of the model, whatever its shape; leave --island-spread out".into());
+    }
+    Ok(NetOptions {
+        islands: IslandOptions {
+            island_spread,
+            panel,
+            tab_height: args.tab.height()?,
+            max_island_faces: args.max_island_faces,
+            flat_fold: args.flat_fold.angle()?,
+        },
+        rigid,
+    })
 }
 
 impl Configured for NetOptions {
@@ -562,21 +567,19 @@ mod tests {
         let panel = options(None).islands.panel;
         let mut values = OptionValues::default();
         values.set("max-island-faces", "0");
-        let refused = Net.configure(&values, panel.clone()).unwrap_err();
+        let refused = resolve(&values, panel.clone()).unwrap_err();
         assert_eq!(
             refused,
             "--max-island-faces: an island holds at least 1 face"
         );
         values.set("max-island-faces", "7");
-        let configured = Net.configure(&values, panel.clone()).unwrap();
-        let net = crate::scheme::AsAny::as_any(&*configured).downcast_ref::<NetOptions>();
-        assert_eq!(net.and_then(|n| n.islands.max_island_faces), Some(7));
+        let net = resolve(&values, panel.clone()).unwrap();
+        assert_eq!(net.islands.max_island_faces, Some(7));
         let shrunk = PanelOptions {
             face_scale: 0.5,
             ..panel
         };
-        assert!(Net
-            .configure(&OptionValues::default(), shrunk)
+        assert!(resolve(&OptionValues::default(), shrunk)
             .unwrap_err()
             .starts_with("--face-scale: the net scheme keeps its faces whole"));
     }

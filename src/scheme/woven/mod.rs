@@ -92,6 +92,14 @@ impl Scheme for Woven {
         values: &OptionValues,
         panel: PanelOptions,
     ) -> Result<Box<dyn Configured>, String> {
+        Ok(Box::new(WovenOptions::resolve(values, panel)?))
+    }
+}
+
+impl WovenOptions {
+    /// Checks the woven options' `values` and fills in their defaults. An error is a
+    /// usage message naming the option.
+    pub fn resolve(values: &OptionValues, panel: PanelOptions) -> Result<WovenOptions, String> {
         let args: WovenArgs = values.parse()?;
         if panel.face_scale >= 1.0 {
             return Err("--face-scale: woven needs a face scale below 1: the strands cross in the gap between the face bands".to_string());
@@ -107,12 +115,12 @@ impl Scheme for Woven {
             ));
         }
         let thickness = thickness("thickness", args.thickness.as_deref(), THICKNESS, &panel)?;
-        Ok(Box::new(WovenOptions {
+        Ok(WovenOptions {
             panel,
             band_scale,
             thickness,
             curl_limit,
-        }))
+        })
     }
 }
 
