@@ -312,3 +312,135 @@ fn too_thick(
         (size * 1.001).ceil()
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scheme::rigid::cutback::cube;
+
+    /// Options every scheme takes, at `face_scale`, on no sheet.
+    fn panel(face_scale: f64) -> PanelOptions {
+        PanelOptions {
+            face_scale,
+            holes: 0,
+            hole_diameter: 3.0,
+            hole_margin: 1.0,
+            label_height: 3.0,
+            panel_limit: None,
+            scale: 1.0,
+        }
+    }
+
+    fn args(connectors: Option<Connectors>, thickness: &str) -> RigidArgs {
+        RigidArgs {
+            connectors,
+            thickness: Some(thickness.to_string()),
+            slot_clearance: None,
+        }
+    }
+
+    #[test]
+    fn card_takes_tabs_and_sheet_takes_brackets() {
+        assert_eq!(
+            RigidArgs::default().resolve(&panel(0.8)),
+            Ok(RigidSheet::CARD)
+        );
+        let sheet = args(None, "3mm").resolve(&panel(1.0)).unwrap();
+        assert_eq!(sheet.connectors, Connectors::Bracket);
+        assert_eq!(
+            sheet.brackets,
+            Some(BracketSizes {
+                thickness: 3.0,
+                clearance: 0.1
+            })
+        );
+        let bare = args(Some(Connectors::None), "3mm").resolve(&panel(1.0));
+        assert_eq!(bare.map(|s| s.brackets), Ok(None));
+    }
+
+    #[test]
+    fn mismatched_options_name_their_fix() {
+        let refused = |a: RigidArgs, face_scale: f64| a.resolve(&panel(face_scale)).unwrap_err();
+        assert!(refused(args(Some(Connectors::Tab), "3mm"), 1.0)
+            .starts_with("--connectors tab: tabs cannot fold in rigid sheet"));
+        assert!(
+            refused(args(Some(Connectors::Bracket), "0mm"), 1.0).starts_with(
+                "--connectors bracket: brackets hold rigid panels; give the material's --thickness"
+            )
+        );
+        assert!(refused(args(None, "3mm"), 0.8).starts_with("--face-scale: rigid panels"));
+        let loose = RigidArgs {
+            slot_clearance: Some("10mm".to_string()),
+            ..args(None, "3mm")
+        };
+        assert!(refused(loose, 1.0).starts_with("--slot-clearance: 10 mm must be"));
+    }
+
+    /// A 200 mm cube in 3 mm sheet, with brackets.
+    fn cube_in_sheet(side: f64, thickness: f64) -> Result<SchemeOutput, SchemeError> {
+        let mesh = cube(side);
+        let sheet = args(None, &format!("{thickness}mm"))
+            .resolve(&panel(1.0))
+            .unwrap();
+        rigid_output(
+            &mesh,
+            &mesh,
+            &sheet,
+            &panel(1.0),
+            &PanelNames::of_faces(&mesh),
+        )
+    }
+
+    #[test]
+    fn a_cube_is_six_panels_held_by_a_bracket_on_every_edge() {
+        let output = cube_in_sheet(200.0, 3.0).unwrap();
+        let ids: Vec<String> = output
+            .panels
+            .iter()
+            .map(|p| p.source.id.to_string())
+            .collect();
+        let faces = ids.iter().filter(|id| id.starts_with('F')).count();
+        let brackets = ids.iter().filter(|id| id.starts_with('B')).count();
+        assert_eq!((faces, brackets), (6, 12), "{ids:?}");
+        assert_eq!(output.connections, 12);
+        assert_eq!(output.thickness, 3.0);
+        let manifest = serde_json::to_value(&output.manifest).unwrap();
+        let rigid = &manifest["rigid"];
+        assert_eq!(rigid["edges_cut"], 12);
+        // At a right angle one panel keeps the edge and the other stops t short.
+        assert_eq!(rigid["widest_edge_cut"], 3.0);
+        assert_eq!(rigid["brackets"], 12);
+        assert_eq!(rigid["edges_without_bracket"], 0);
+        assert!(output.notes.is_empty(), "{:?}", output.notes);
+    }
+
+    #[test]
+    fn too_thick_names_a_thickness_and_a_size_that_build() {
+        let Err(SchemeError::Options(message)) = cube_in_sheet(20.0, 12.0) else {
+            panic!("12 mm sheet on a 20 mm cube is refused");
+        };
+        assert!(
+            message.starts_with("--thickness 12mm is too thick for this model at this size"),
+            "{message}"
+        );
+        let number_after = |key: &str| -> f64 {
+            let rest = &message[message.find(key).expect(key) + key.len()..];
+            let end = rest.find("mm").expect("a length in mm");
+            rest[..end].parse().expect("a number")
+        };
+        let fits = number_after("; --thickness ");
+        let size = number_after("--size ");
+        assert!(fits > 0.0 && fits < 12.0, "{message}");
+        assert!(
+            cube_in_sheet(20.0, fits).is_ok(),
+            "the advised {fits} mm builds"
+        );
+        // The cube's side is its longest side, so the advised size is the side at which
+        // 12 mm takes: it builds, and is at least 20 mm.
+        assert!(size > 20.0, "{message}");
+        assert!(
+            cube_in_sheet(size, 12.0).is_ok(),
+            "the advised size {size} mm builds"
+        );
+    }
+}
