@@ -9,6 +9,7 @@ use super::grow::Islands;
 use super::options::{IslandOptions, MATCH};
 use crate::mesh::{EdgeId, FaceId, Mesh};
 use crate::panel::{Hole, Label, LabelKind, Loops, Name, Panel, Source};
+use crate::scheme::kit::labels::longest_side_direction;
 use crate::scheme::kit::tab::Tab;
 
 /// What every island's panel is built from.
@@ -164,17 +165,10 @@ fn island_label(net: &BuiltNet, id: Name, faces: &[u32]) -> Label {
     let mesh = net.mesh;
     let label_face = central_face(mesh, net.islands, faces);
     let corners: Vec<DVec3> = mesh.face_positions(FaceId(label_face)).collect();
-    let longest = (0..corners.len())
-        .max_by(|&i, &j| {
-            let li = corners[i].distance(corners[(i + 1) % corners.len()]);
-            let lj = corners[j].distance(corners[(j + 1) % corners.len()]);
-            li.total_cmp(&lj).then(j.cmp(&i))
-        })
-        .unwrap_or(0);
     Label {
         text: id,
         anchor: mesh.face_centre(FaceId(label_face)),
-        direction: (corners[(longest + 1) % corners.len()] - corners[longest]).normalize(),
+        direction: longest_side_direction(&corners),
         height: net.options.panel.label_height,
         facet: net.facet_of[label_face as usize],
         kind: LabelKind::Panel,

@@ -16,17 +16,10 @@ pub(in crate::scheme) fn outline_labels(
     height: f64,
 ) -> Vec<Label> {
     let n = points.len();
-    let longest = (0..n)
-        .max_by(|&i, &j| {
-            let li = points[i].distance(points[(i + 1) % n]);
-            let lj = points[j].distance(points[(j + 1) % n]);
-            li.total_cmp(&lj).then(j.cmp(&i))
-        })
-        .unwrap_or(0);
     let mut labels = vec![Label {
         text: id,
         anchor,
-        direction: (points[(longest + 1) % n] - points[longest]).normalize(),
+        direction: longest_side_direction(points),
         height,
         facet: 0,
         kind: LabelKind::Panel,
@@ -48,4 +41,18 @@ pub(in crate::scheme) fn outline_labels(
         });
     }
     labels
+}
+
+/// The direction of a polygon's longest side (the first of equal ones), along which a
+/// panel's id reads: the side a builder sees first.
+pub(in crate::scheme) fn longest_side_direction(points: &[DVec3]) -> DVec3 {
+    let n = points.len();
+    let longest = (0..n)
+        .max_by(|&i, &j| {
+            let li = points[i].distance(points[(i + 1) % n]);
+            let lj = points[j].distance(points[(j + 1) % n]);
+            li.total_cmp(&lj).then(j.cmp(&i))
+        })
+        .unwrap_or(0);
+    (points[(longest + 1) % n] - points[longest]).normalize()
 }
