@@ -533,7 +533,7 @@ mod tests {
         }
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
         // What a panel costs beside its items, against an owned panel's struct (the
-        // figures in docs/architecture.md).
+        // figures in docs/DESIGN.md).
         assert_eq!(std::mem::size_of::<PanelHead>(), 72);
         assert_eq!(std::mem::size_of::<FlatHead>(), 64);
         assert_eq!(std::mem::size_of::<Panel>(), 168);
