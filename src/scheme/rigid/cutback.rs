@@ -13,6 +13,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DVec2, DVec3};
 
+use crate::mesh::distance::TriangleGrid;
 use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
 
 /// Two parts may overlap by this much (mm): rounding, not material.
@@ -110,6 +111,7 @@ pub fn rigid_panels(
         outlines.push(outline);
     }
     let solid = Solid::of(surface);
+    let nearest = TriangleGrid::new(&solid.triangles);
     let mut vertices_cut = Vec::new();
     for v in mesh.vertices() {
         let at = Corner {
@@ -118,6 +120,7 @@ pub fn rigid_panels(
             thickness,
             frames: &frames,
             solid: &solid,
+            nearest: &nearest,
         };
         if let Some(r) = at.cut_back(&mut outlines)? {
             vertices_cut.push((v, r));
@@ -291,6 +294,8 @@ struct Corner<'a> {
     thickness: f64,
     frames: &'a [FaceFrame],
     solid: &'a Solid,
+    /// The solid's triangles, for how far a point lies outside it.
+    nearest: &'a TriangleGrid<'a>,
 }
 
 impl Corner<'_> {
@@ -403,7 +408,7 @@ impl Corner<'_> {
                     (q - plane.origin).dot(plane.normal) <= 0.0
                 });
                 if !below_all {
-                    let depth = self.solid.outside_by(q);
+                    let depth = self.solid.outside_by(q, self.nearest);
                     note(
                         depth,
                         RigidError::SticksOut {
@@ -544,17 +549,13 @@ impl Solid {
         crossings % 2 == 1
     }
 
-    /// How far `q` lies outside the solid (mm); zero inside, or when the model is open.
-    fn outside_by(&self, q: DVec3) -> f64 {
+    /// How far `q` lies outside the solid (mm), measured to `nearest`, the grid of its
+    /// triangles; zero inside, or when the model is open.
+    fn outside_by(&self, q: DVec3, nearest: &TriangleGrid) -> f64 {
         if self.triangles.is_empty() || self.contains(q) {
             return 0.0;
         }
-        self.triangles
-            .iter()
-            .map(|&[a, b, c]| {
-                q.distance(crate::mesh::distance::closest_point_on_triangle(q, a, b, c))
-            })
-            .fold(f64::INFINITY, f64::min)
+        nearest.distance(q)
     }
 }
 
@@ -995,6 +996,7 @@ mod tests {
     fn rays_find_the_inside_even_through_shared_edges() {
         let mesh = cube(100.0);
         let solid = Solid::of(&mesh);
+        let nearest = TriangleGrid::new(&solid.triangles);
         assert!(solid.contains(DVec3::splat(50.0)));
         for q in [
             DVec3::new(50.0, 50.0, 101.0),
@@ -1003,9 +1005,9 @@ mod tests {
         ] {
             assert!(!solid.contains(q), "{q}");
         }
-        assert!((solid.outside_by(DVec3::new(50.0, 50.0, 101.0)) - 1.0).abs() < 1e-9);
-        assert!((solid.outside_by(DVec3::new(150.0, 50.0, 50.0)) - 50.0).abs() < 1e-9);
-        assert_eq!(solid.outside_by(DVec3::splat(50.0)), 0.0);
+        assert!((solid.outside_by(DVec3::new(50.0, 50.0, 101.0), &nearest) - 1.0).abs() < 1e-9);
+        assert!((solid.outside_by(DVec3::new(150.0, 50.0, 50.0), &nearest) - 50.0).abs() < 1e-9);
+        assert_eq!(solid.outside_by(DVec3::splat(50.0), &nearest), 0.0);
         // Rays through the diagonal the top and bottom faces' triangles share cross
         // each face once, not twice.
         for t in [10.0, 25.0, 50.0, 75.0, 90.0] {
