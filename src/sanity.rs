@@ -728,14 +728,10 @@ fn trial(job: &Job, mesh: &Mesh) -> Trial {
     else {
         return Trial::TooCoarse;
     };
-    let usable = (
-        job.sheet.width - 2.0 * job.margin,
-        job.sheet.height - 2.0 * job.margin,
-    );
-    let rotations = job.nest.search.rotations;
+    let limit = job.scheme.panel().panel_limit;
     if !flat
         .iter()
-        .all(|p| crate::plane::fits_rotated(&p.outer(), rotations, usable.0, usable.1))
+        .all(|p| limit.is_none_or(|limit| limit.fits(&p.outer(), 0.0)))
     {
         return Trial::TooCoarse;
     }

@@ -88,7 +88,7 @@ impl BuildOptions {
                 &self.label_height,
                 defaults::LABEL_HEIGHT,
             )?,
-            panel_limit: Some(sheet.panel_limit(nest.search.rotations)),
+            panel_limit: Some(sheet.panel_limit(nest.search.rotations, cuts.kerf)),
             scale: self
                 .model
                 .scale
@@ -344,11 +344,12 @@ struct SheetSettings {
 }
 
 impl SheetSettings {
-    /// The largest panel the sheet takes inside its margins, in `rotations` steps.
-    fn panel_limit(&self, rotations: u32) -> PanelLimit {
+    /// The largest panel the sheet takes inside its margins, in `rotations` steps,
+    /// before the kerf compensation grows it by half the `kerf` on every side.
+    fn panel_limit(&self, rotations: u32, kerf: f64) -> PanelLimit {
         PanelLimit {
-            width: self.sheet.width - 2.0 * self.margin,
-            height: self.sheet.height - 2.0 * self.margin,
+            width: self.sheet.width - 2.0 * self.margin - kerf,
+            height: self.sheet.height - 2.0 * self.margin - kerf,
             rotations,
         }
     }

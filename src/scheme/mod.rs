@@ -167,6 +167,26 @@ pub struct PanelLimit {
     pub rotations: u32,
 }
 
+/// Room (mm) kept between a part and the usable sheet when a scheme checks that the
+/// part fits: the nester sees the outline flattened again from 3D and written to
+/// 0.0001 mm, and a part that fitted only to the last micrometre would be refused.
+pub const FIT_SLACK: f64 = 0.5;
+
+impl PanelLimit {
+    /// True when `outline` fits the usable sheet less `room` on every side's total
+    /// (and the [`FIT_SLACK`]) in one of the nesters' rotations: the one check every
+    /// scheme makes before it hands a part on.
+    pub fn fits(&self, outline: &[glam::DVec2], room: f64) -> bool {
+        let spare = room + FIT_SLACK;
+        crate::plane::fits_rotated(
+            outline,
+            self.rotations,
+            self.width - spare,
+            self.height - spare,
+        )
+    }
+}
+
 /// Option values as the user wrote them, by long option name (`"bridge-scale"` →
 /// `"0.4"`; a switch is `"true"` or `"false"`). The command line and the config file
 /// both fill it, so a scheme parses its options in one place.

@@ -7,8 +7,8 @@
 use glam::{DVec2, DVec3};
 
 use super::island::{
-    fits_sheet, grow_islands, island_net, FlatFoldArgs, IslandNames, IslandOptions, FIT_SLACK,
-    FLAT_FOLD_DEG, ISLAND,
+    fits_sheet, grow_islands, island_net, FlatFoldArgs, IslandNames, IslandOptions, FLAT_FOLD_DEG,
+    ISLAND,
 };
 use super::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
 use super::rigid::sheet::{
@@ -206,7 +206,7 @@ const FLAT_REGION_TOLERANCE: f64 = 0.005;
 fn rigid_panels(mesh: &Mesh, options: &NetOptions) -> Result<SchemeOutput, SchemeError> {
     let fits = |corners: &[DVec2]| {
         let hull = convex_hull(corners);
-        fits_sheet(&hull, &options.islands, FIT_SLACK).then_some(hull)
+        fits_sheet(&hull, &options.islands, 0.0).then_some(hull)
     };
     let rules = RegionRules {
         tolerance: FLAT_REGION_TOLERANCE,

@@ -9,9 +9,7 @@ use super::grow::{fold_angle, Islands, JoinRules};
 use super::options::{IslandOptions, ISLAND};
 use super::panel::{island_panel, BuiltNet};
 use super::summary::Summary;
-use super::tabs::{
-    clear_tab, fits_sheet, tab_options, Obstacle, FIT_SLACK, ISLAND_GAP, NOTCH_GAP, TAB_STEPS,
-};
+use super::tabs::{clear_tab, fits_sheet, tab_options, Obstacle, ISLAND_GAP, NOTCH_GAP, TAB_STEPS};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::surface::group_anchor;
 use crate::panel::{Covers, FaceGroup, Name, Panel, Source};
@@ -243,7 +241,7 @@ fn place_tabs(
                 let mut hull = hulls[island as usize].clone();
                 hull.extend_from_slice(&outline);
                 let hull = convex_hull(&hull);
-                if !fits_sheet(&hull, options, FIT_SLACK) {
+                if !fits_sheet(&hull, options, 0.0) {
                     continue;
                 }
                 hulls[island as usize] = hull;

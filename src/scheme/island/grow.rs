@@ -8,8 +8,8 @@ use glam::DVec2;
 
 use super::options::IslandOptions;
 use super::tabs::{
-    clear_tab, fits_sheet, separation, tab_options, Obstacle, TabFrame, FIT_SLACK, ISLAND_GAP,
-    NOTCH_GAP, TAB_STEPS,
+    clear_tab, fits_sheet, separation, tab_options, Obstacle, TabFrame, ISLAND_GAP, NOTCH_GAP,
+    TAB_STEPS,
 };
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::plane::convex_hull;
@@ -210,7 +210,7 @@ impl Islands {
             return false;
         }
         // Room for a tab's depth: tabs that would still stick out are cut back.
-        if !fits_sheet(&hull, options, options.tab_height + FIT_SLACK) {
+        if !fits_sheet(&hull, options, options.tab_height) {
             return false;
         }
 

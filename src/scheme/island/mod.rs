@@ -36,5 +36,5 @@ pub(in crate::scheme) use grow::grow_islands;
 pub(in crate::scheme) use options::{FlatFoldArgs, FLAT_FOLD_DEG};
 pub use options::{IslandOptions, ISLAND, MATCH};
 pub use summary::Summary;
+pub(in crate::scheme) use tabs::fits_sheet;
 pub use tabs::ISLAND_GAP;
-pub(in crate::scheme) use tabs::{fits_sheet, FIT_SLACK};

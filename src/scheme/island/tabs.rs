@@ -5,16 +5,12 @@ use glam::{DVec2, DVec3};
 
 use super::options::IslandOptions;
 use crate::mesh::{HalfedgeId, Mesh};
-use crate::plane::fits_rotated;
 use crate::scheme::kit::tab::{Tab, TabOptions};
 
 /// Least distance (mm) between two faces or tabs of one island that are not joined:
 /// the laser needs room between two cuts, and an outline that touches itself is not
 /// one loop.
 pub const ISLAND_GAP: f64 = 0.5;
-
-/// Slack (mm) kept when checking that an island fits the usable sheet.
-pub(in crate::scheme) const FIT_SLACK: f64 = 4.0;
 
 /// Tab heights tried, as fractions of `--tab-height`, before a tab is left out.
 pub(super) const TAB_STEPS: [f64; 3] = [1.0, 0.5, 0.25];
@@ -224,15 +220,10 @@ pub(super) fn clear_tab(
     Some((cleared, outline))
 }
 
-/// True when `hull` fits the usable sheet less `room` in one of the nesters'
-/// rotations (always, without a sheet).
+/// True when `hull` fits the usable sheet less `room` (always, without a sheet).
 pub(in crate::scheme) fn fits_sheet(hull: &[DVec2], options: &IslandOptions, room: f64) -> bool {
-    options.panel.panel_limit.is_none_or(|limit| {
-        fits_rotated(
-            hull,
-            limit.rotations,
-            limit.width - room,
-            limit.height - room,
-        )
-    })
+    options
+        .panel
+        .panel_limit
+        .is_none_or(|limit| limit.fits(hull, room))
 }

@@ -7,10 +7,9 @@ use super::ribbon::Ribbon;
 use crate::mesh::geometry::vector_area;
 use crate::panel::FacetFrame;
 use crate::plane::{
-    clip_convex, contains, convex_hull, counter_clockwise, fits_rotated, segment_distance,
-    smallest_box,
+    clip_convex, contains, convex_hull, counter_clockwise, segment_distance, smallest_box,
 };
-use crate::scheme::PanelLimit;
+use crate::scheme::{PanelLimit, FIT_SLACK};
 
 /// Parts of a ribbon closer than this (mm) when unrolled, that share no corner, are
 /// treated as touching: the segment is cut before them.
@@ -18,10 +17,6 @@ const CLEARANCE: f64 = 0.5;
 
 /// Two facets sharing a corner overlap when their intersection exceeds this (mm²).
 const OVERLAP_AREA: f64 = 1e-4;
-
-/// The ends of a segment fit the sheet with this much to spare (mm), for the nester's
-/// rounding.
-const FIT_SLACK: f64 = 0.5;
 
 /// Most start positions tried when cutting a ring into segments.
 const MAX_STARTS: usize = 64;
@@ -168,10 +163,9 @@ fn apart(a: &FlatFacet, b: &FlatFacet) -> bool {
 /// segment that only fits across the sheet's diagonal would take a sheet of its own.
 fn fits(points: &[DVec2], limit: &PanelLimit) -> bool {
     let hull = convex_hull(points);
-    let steps = limit.rotations.max(1);
     let (w, h) = (limit.width - FIT_SLACK, limit.height - FIT_SLACK);
-    let compact = smallest_box(&hull, steps);
-    fits_rotated(&hull, steps, w, h)
+    let compact = smallest_box(&hull, limit.rotations.max(1));
+    limit.fits(&hull, 0.0)
         && ((compact.x <= w && compact.y <= h) || (compact.x <= h && compact.y <= w))
 }
 
