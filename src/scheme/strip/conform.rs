@@ -240,7 +240,7 @@ fn split_outline_edge(strip: &mut Strip, a: u32, b: u32, inside: &[DVec3]) {
 mod tests {
     use super::*;
     use crate::scheme::strip::band::band;
-    use crate::scheme::strip::test_shapes::{banded, check_strips_cut, heights, tube, two_lines};
+    use crate::scheme::strip::test_shapes::{check_strips_cut, cover, heights, tube, two_lines};
 
     #[test]
     fn a_strip_that_comes_back_over_a_triangle_runs_back_and_a_band_does_not() {
@@ -269,7 +269,7 @@ mod tests {
         let barrel = tube(48, 24, 120.0, |h| {
             40.0 + 20.0 * (std::f64::consts::PI * h / 120.0).sin()
         });
-        let strips = banded(&barrel, &heights(&barrel), 1.0, 200.0)
+        let strips = cover(&barrel, &heights(&barrel), 1.0, 200.0)
             .unwrap()
             .strips;
         for strip in &strips {

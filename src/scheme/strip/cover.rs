@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use super::band::{strip_soup, Strip};
 use super::conform::{conform, runs_back};
 use super::distance::distance_beyond;
-use super::patch::{Cover, Patch, RunsBack};
+use super::patch::{CoverSettings, Patch, RunsBack};
 use super::sectors::Sectors;
 use super::slices::{Region, Slices};
 use super::surface::Triangles;
@@ -16,7 +16,7 @@ use super::welded::Welded;
 
 /// Strips covering a surface, each within the distance asked of the part of the
 /// surface it covers, both ways.
-pub(super) struct Banded {
+pub(super) struct Cover {
     /// The strips, their outlines meeting point for point.
     pub(super) strips: Vec<Strip>,
     /// The largest distance measured between a strip and the part it covers, either way.
@@ -34,7 +34,7 @@ const MOST_TRIES: usize = 12;
 /// How many times a part of the surface is split before the bound is given up on.
 const MOST_SPLITS: usize = 40;
 
-/// How [`Cover::strips`] ends the error of a band that strays from the surface however
+/// How [`CoverSettings::strips`] ends the error of a band that strays from the surface however
 /// narrow it is split: the one failure a larger bound can mend.
 pub(super) const STAYS_OFF: &str = "mm from the surface";
 
@@ -56,7 +56,7 @@ pub(super) fn strips_ridged(
     sector_length: f64,
     ridged: bool,
     runs_back: RunsBack,
-) -> Result<Banded, String> {
+) -> Result<Cover, String> {
     let (lo, hi) = field
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
@@ -67,7 +67,7 @@ pub(super) fn strips_ridged(
     }
     let span = (hi - lo).max(1e-9);
     let spacing = tolerance / 3.0;
-    let cover = Cover {
+    let cover = CoverSettings {
         ridged,
         within: tolerance,
         simplify: SIMPLIFY * tolerance,
@@ -86,7 +86,7 @@ pub(super) fn strips_ridged(
     let deviation = covered.iter().map(|c| c.1).fold(0.0, f64::max);
     let mut strips: Vec<Strip> = covered.into_iter().map(|c| c.0).collect();
     conform(&mut strips);
-    Ok(Banded { strips, deviation })
+    Ok(Cover { strips, deviation })
 }
 
 /// How deep a patch lies in the splitting, and whether its strips may fold over their
@@ -107,12 +107,12 @@ impl Depth {
 }
 
 /// A strip and the distance measured between it and its part of the surface.
-type Covered = (Strip, f64);
+type MeasuredStrip = (Strip, f64);
 
-impl Cover {
+impl CoverSettings {
     /// The strips of `patch`: one if it is within, else those of its sectors or of
     /// the bands it is split into.
-    fn strips(&self, patch: &Patch, depth: Depth) -> Result<Vec<Covered>, String> {
+    fn strips(&self, patch: &Patch, depth: Depth) -> Result<Vec<MeasuredStrip>, String> {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
         let one = vec![lo - margin, hi + margin];
@@ -156,7 +156,7 @@ impl Cover {
                 // A sector's strip folded over onto its neighbour (round a sharp tip):
                 // this band is cut into sectors twice as long instead, and once they
                 // would be longer than it, covered whole.
-                let longer = Cover {
+                let longer = CoverSettings {
                     sector_length: 2.0 * self.sector_length,
                     ..*self
                 };
@@ -190,7 +190,12 @@ impl Cover {
     /// strip would fold over its outline). Only halves: a strip strays where the
     /// surface is sharpest, so more bands guessed from its distance would be as narrow
     /// everywhere else, and bands once split are never joined.
-    fn split(&self, patch: &Patch, deviation: f64, depth: Depth) -> Result<Vec<Covered>, String> {
+    fn split(
+        &self,
+        patch: &Patch,
+        deviation: f64,
+        depth: Depth,
+    ) -> Result<Vec<MeasuredStrip>, String> {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
         let parts = match deviation.is_finite() {
@@ -224,7 +229,7 @@ impl Cover {
         regions: &[Region],
         kept: &[bool],
         depth: Depth,
-    ) -> Result<Vec<Covered>, String> {
+    ) -> Result<Vec<MeasuredStrip>, String> {
         flattened(
             regions
                 .par_iter()
@@ -242,7 +247,7 @@ impl Cover {
         kept: &[bool],
         folds: bool,
         limit: f64,
-    ) -> Result<Covered, String> {
+    ) -> Result<MeasuredStrip, String> {
         let strip = slices.strip(region, kept, !folds)?;
         if strip.triangles.is_empty() {
             return Err(format!(
@@ -282,7 +287,7 @@ impl Cover {
     /// The strips of `patch` in bands from its lower curve up, each as wide as keeps
     /// its strips within (found by widening and halving the step from `first`, a
     /// guess), the last up to its upper curve.
-    fn grown(&self, patch: &Patch, first: f64) -> Option<Vec<Covered>> {
+    fn grown(&self, patch: &Patch, first: f64) -> Option<Vec<MeasuredStrip>> {
         let [lo, hi] = patch.ends;
         let mut sorted = patch.values.clone();
         sorted.sort_by(f64::total_cmp);
@@ -292,7 +297,7 @@ impl Cover {
         let mut step = first.max(least);
         while from < hi {
             // The widest band found within so far, and the narrowest found not.
-            let mut within: Option<(f64, Vec<Covered>)> = None;
+            let mut within: Option<(f64, Vec<MeasuredStrip>)> = None;
             let mut beyond = f64::INFINITY;
             for _ in 0..MOST_TRIES {
                 let to = match from + step >= hi - 0.1 * step {
@@ -335,7 +340,7 @@ impl Cover {
 
     /// The strips of the band of `patch` between values `from` and `to`, if every one
     /// is within.
-    fn band_within(&self, patch: &Patch, from: f64, to: f64) -> Option<Vec<Covered>> {
+    fn band_within(&self, patch: &Patch, from: f64, to: f64) -> Option<Vec<MeasuredStrip>> {
         let [lo, hi] = patch.ends;
         let margin = 1e-3 * (hi - lo);
         let mut levels = vec![lo - margin];
@@ -344,7 +349,7 @@ impl Cover {
         let band = usize::from(from > lo);
         let (slices, kept) = self.sliced(patch, levels);
         let regions = slices.regions_of(band);
-        let measured: Vec<Option<Covered>> = regions
+        let measured: Vec<Option<MeasuredStrip>> = regions
             .par_iter()
             .map(|r| {
                 let covered = self.measured(&slices, r, &kept, false, self.within).ok();
@@ -357,7 +362,7 @@ impl Cover {
 
 /// Whether the strips of `covered` join into one surface where they meet (none folded
 /// over onto another).
-fn joined(covered: &[Covered]) -> bool {
+fn joined(covered: &[MeasuredStrip]) -> bool {
     let mut strips: Vec<Strip> = covered.iter().map(|c| c.0.clone()).collect();
     conform(&mut strips);
     Welded::new(&strips).is_ok()
@@ -365,9 +370,9 @@ fn joined(covered: &[Covered]) -> bool {
 
 /// The results of `parts`, in order, each part's strips one after the other.
 fn flattened(
-    parts: impl IndexedParallelIterator<Item = Result<Vec<Covered>, String>>,
-) -> Result<Vec<Covered>, String> {
-    let parts: Vec<Result<Vec<Covered>, String>> = parts.collect();
+    parts: impl IndexedParallelIterator<Item = Result<Vec<MeasuredStrip>, String>>,
+) -> Result<Vec<MeasuredStrip>, String> {
+    let parts: Vec<Result<Vec<MeasuredStrip>, String>> = parts.collect();
     let mut all = Vec::new();
     for part in parts {
         all.extend(part?);
@@ -427,7 +432,7 @@ mod tests {
     #[test]
     fn strips_folded_over_their_neighbour_do_not_join() {
         let at = |x: f64, y: f64| DVec3::new(x, y, 0.0);
-        let strip = |points: Vec<DVec3>| -> Covered {
+        let strip = |points: Vec<DVec3>| -> MeasuredStrip {
             let triangles = vec![[0, 1, 2]];
             (Strip { points, triangles }, 0.0)
         };

@@ -46,7 +46,7 @@ use cover::STAYS_OFF;
 use field::{closed_part, Closed};
 use pieces::clear_pieces;
 use surface::Triangles;
-use tolerance::{covered_with, simplification_distance, too_simplified, Covering};
+use tolerance::{cover_within, simplification_distance, too_simplified, WeldedCover};
 
 pub use welded::STRIP;
 
@@ -285,14 +285,14 @@ fn strip_panels(
     let sector_length = limit.map_or(f64::INFINITY, |l| l.width.min(l.height));
     // A strip longer than the sheet's longer side is cut into equal pieces no longer.
     let piece_length = limit.map_or(f64::INFINITY, |l| l.width.max(l.height));
-    let covered_with =
-        |closed: Closed| covered_with(&surface, closed, bound, unsimplified, sector_length);
+    let cover_within =
+        |closed: Closed| cover_within(&surface, closed, bound, unsimplified, sector_length);
     // A harmonic field between two poles stays nearly level along a dead end (a
     // horse's legs), too flat to split into bands; the distance from one pole rises
     // along every branch. The first failure is the one told.
-    let covered = match covered_with(Closed::Harmonic) {
+    let covered = match cover_within(Closed::Harmonic) {
         Err(SchemeError::Model(why)) if closed_part(&surface) => {
-            covered_with(Closed::Distance).map_err(|_| SchemeError::Model(why))
+            cover_within(Closed::Distance).map_err(|_| SchemeError::Model(why))
         }
         other => other,
     };
@@ -307,8 +307,8 @@ fn strip_panels(
         }
         (other, _) => other?,
     };
-    let Covering {
-        banded,
+    let WeldedCover {
+        cover,
         welded,
         whole_bands,
         tolerance,
@@ -329,7 +329,7 @@ fn strip_panels(
         ),
         Some(_) => format!(
             "strip: {} strips in {pieces} pieces, at most {measured:.2} mm from the model as given (before simplifying) both ways as measured (bound {bound:.2} mm; within {:.2} mm of the simplified model); each piece unrolls exactly",
-            welded.strips, banded.deviation
+            welded.strips, cover.deviation
         ),
     }];
     if tolerance < bound {
@@ -362,7 +362,7 @@ fn strip_panels(
         .into();
     if unsimplified.is_some() {
         section["simplified_bound"] = round4(tolerance).into();
-        section["simplified_deviation"] = round4(banded.deviation).into();
+        section["simplified_deviation"] = round4(cover.deviation).into();
     }
     output.manifest.push("strip", section);
     output.surface = Some(welded.mesh);

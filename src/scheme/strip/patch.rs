@@ -1,5 +1,5 @@
-//! What the covering of a surface by strips works on and with: a patch of the surface
-//! between two values of the field, and the covering's settings, shared by the
+//! What covering a surface with strips works on and with: a patch of the surface
+//! between two values of the field, and the cover's settings, shared by the
 //! slicing, the sectors and the covering.
 
 use super::surface::Triangles;
@@ -18,7 +18,7 @@ pub(super) struct Patch {
 
 /// How [`strips_ridged`](super::cover::strips_ridged) covers the surface.
 #[derive(Clone, Copy)]
-pub(super) struct Cover {
+pub(super) struct CoverSettings {
     /// The field is a distance from rims, its saddles ridges
     /// ([`field_of`](super::field::field_of)).
     pub(super) ridged: bool,

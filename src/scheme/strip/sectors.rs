@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use super::patch::{Cover, Patch};
+use super::patch::{CoverSettings, Patch};
 use super::slices::shortest_bridge;
 use super::surface::{boundary_loops, cycle_pairs, edge_uses, renumbered, Triangles};
 use crate::union_find::UnionFind;
@@ -20,9 +20,9 @@ pub(super) enum Sectors {
     Unfit,
 }
 
-impl Cover {
+impl CoverSettings {
     /// `patch` cut across, from its lower curve to its upper one, into sectors about
-    /// [`Cover::sector_length`] long; `None` where it is shorter or has no way across.
+    /// [`CoverSettings::sector_length`] long; `None` where it is shorter or has no way across.
     pub(super) fn sectors(&self, patch: &Patch) -> Sectors {
         let corners = &patch.surface.corners;
         let [lo, hi] = patch.ends;
@@ -79,7 +79,7 @@ impl Cover {
     }
 
     /// Where to cut a run of a patch's outline on its lower curve: its kept points
-    /// nearest even steps of [`Cover::sector_length`] or less along it (from its first
+    /// nearest even steps of [`CoverSettings::sector_length`] or less along it (from its first
     /// point on a closed run, between its ends on an open one); none on a run too
     /// short to cut.
     fn cut_points(&self, patch: &Patch, run: &[u32], closed: bool) -> Vec<u32> {

@@ -9,7 +9,7 @@ use glam::{DVec2, DVec3};
 
 use super::band::{strip_soup, Strip};
 use super::conform::outline_of;
-use super::cover::{strips_ridged, Banded};
+use super::cover::{strips_ridged, Cover};
 use super::distance::one_way_distance;
 use super::field::{ridged, Closed};
 use super::patch::RunsBack;
@@ -95,20 +95,20 @@ pub(super) fn check_strips_cut(
     sector_length: f64,
 ) -> usize {
     let clock = std::time::Instant::now();
-    let banded = banded(surface, field, tolerance, sector_length).unwrap();
+    let cover = cover(surface, field, tolerance, sector_length).unwrap();
     eprintln!(
         "{} strips, deviation {:.3} in {:?}",
-        banded.strips.len(),
-        banded.deviation,
+        cover.strips.len(),
+        cover.deviation,
         clock.elapsed()
     );
-    let soup = strip_soup(&banded.strips);
+    let soup = strip_soup(&cover.strips);
     let whole = surface.soup();
     let out = one_way_distance(&soup, &whole, tolerance / 10.0);
     let back = one_way_distance(&whole, &soup, tolerance / 10.0);
     assert!(out <= tolerance && back <= tolerance, "{out} {back}");
     let size = extent_of(&surface.points);
-    for strip in &banded.strips {
+    for strip in &cover.strips {
         let outline = outline_of(strip);
         for v in strip.triangles.iter().flatten() {
             assert!(
@@ -128,7 +128,7 @@ pub(super) fn check_strips_cut(
     // Outline edges by their ends' positions, as the triangles run.
     let key = |p: DVec3| p.to_array().map(f64::to_bits);
     let mut outlines: BTreeMap<([u64; 3], [u64; 3]), usize> = BTreeMap::new();
-    for (s, strip) in banded.strips.iter().enumerate() {
+    for (s, strip) in cover.strips.iter().enumerate() {
         for (_, a, b) in outline_of(strip) {
             let edge = (key(strip.points[a as usize]), key(strip.points[b as usize]));
             assert!(
@@ -139,7 +139,7 @@ pub(super) fn check_strips_cut(
     }
     // No edge has more than two triangles: the strips do not overlap.
     let mut uses: BTreeMap<([u64; 3], [u64; 3]), usize> = BTreeMap::new();
-    for strip in &banded.strips {
+    for strip in &cover.strips {
         for t in &strip.triangles {
             for (a, b) in cycle_pairs(t) {
                 let (a, b) = (key(strip.points[a as usize]), key(strip.points[b as usize]));
@@ -168,17 +168,17 @@ pub(super) fn check_strips_cut(
             from(b)
         );
     }
-    banded.strips.len()
+    cover.strips.len()
 }
 
 /// The strips of `surface` within `tolerance`, as the scheme covers a surface whose
 /// closed parts have a harmonic field, bands cut into sectors `sector_length` long.
-pub(super) fn banded(
+pub(super) fn cover(
     surface: &Triangles,
     field: &[f64],
     tolerance: f64,
     sector_length: f64,
-) -> Result<Banded, String> {
+) -> Result<Cover, String> {
     let ridged = ridged(surface, Closed::Harmonic);
     strips_ridged(
         surface,

@@ -5,7 +5,7 @@
 use glam::DVec3;
 
 use super::band::strip_soup;
-use super::cover::{strips_ridged, Banded, STAYS_OFF};
+use super::cover::{strips_ridged, Cover, STAYS_OFF};
 use super::distance::{distance_beyond, one_way_distance};
 use super::field::{evened, field_of, ridged, Closed};
 use super::patch::RunsBack;
@@ -16,13 +16,13 @@ use crate::scheme::SchemeError;
 /// The strips of `surface` within `bound` of the model (of `unsimplified`, where the
 /// surface was simplified from it), with `closed` parts' field, and the largest
 /// distance measured.
-pub(super) fn covered_with(
+pub(super) fn cover_within(
     surface: &Triangles,
     closed: Closed,
     bound: f64,
     unsimplified: Option<&[[DVec3; 3]]>,
     sector_length: f64,
-) -> Result<(Covering, f64), SchemeError> {
+) -> Result<(WeldedCover, f64), SchemeError> {
     let ridged = ridged(surface, closed);
     let surface = match ridged {
         true => surface.rims_apart(),
@@ -32,11 +32,11 @@ pub(super) fn covered_with(
         &surface,
         &field_of(&surface, closed).map_err(SchemeError::Model)?,
     );
-    let cover = |tolerance: f64| covering(&surface, &field, tolerance, sector_length, ridged);
+    let cover = |tolerance: f64| welded_cover(&surface, &field, tolerance, sector_length, ridged);
     match unsimplified {
         None => {
             let covered = cover(bound)?;
-            let measured = covered.banded.deviation;
+            let measured = covered.cover.deviation;
             Ok((covered, measured))
         }
         Some(unsimplified) => within_unsimplified(bound, &surface.soup(), unsimplified, &cover),
@@ -44,8 +44,8 @@ pub(super) fn covered_with(
 }
 
 /// The strips of a surface within a tolerance, welded.
-pub(super) struct Covering {
-    pub(super) banded: Banded,
+pub(super) struct WeldedCover {
+    pub(super) cover: Cover,
     pub(super) welded: Welded,
     /// Bands were kept whole: their sectors' strips overlapped.
     pub(super) whole_bands: bool,
@@ -55,23 +55,23 @@ pub(super) struct Covering {
 
 /// The strips of `surface` within `tolerance` ([`strips_ridged`]), welded into one
 /// surface; where the sectors' strips of neighbouring bands overlap, every band whole.
-fn covering(
+fn welded_cover(
     surface: &Triangles,
     field: &[f64],
     tolerance: f64,
     sector_length: f64,
     ridged: bool,
-) -> Result<Covering, SchemeError> {
+) -> Result<WeldedCover, SchemeError> {
     let within = |sector_length: f64, runs_back: RunsBack| {
         strips_ridged(surface, field, tolerance, sector_length, ridged, runs_back).map_err(|e| {
-            let fix = covering_fix(surface, &e);
+            let fix = cover_fix(surface, &e);
             SchemeError::Model(format!(
                 "no strips within {tolerance:.3} mm of the model: {e}; {fix}"
             ))
         })
     };
-    let mut banded = within(sector_length, RunsBack::Welded)?;
-    let mut welded = Welded::new(&banded.strips);
+    let mut cover = within(sector_length, RunsBack::Welded)?;
+    let mut welded = Welded::new(&cover.strips);
     // Each band's sectors were checked to join as they were cut; where strips of
     // neighbouring bands still overlap, every band is kept whole instead, and where
     // they still do not join, a strip that runs back over itself is split as it is
@@ -91,12 +91,12 @@ fn covering(
         };
         if let Ok(joined) = Welded::new(&again.strips) {
             whole_bands = length > sector_length;
-            (banded, welded) = (again, Ok(joined));
+            (cover, welded) = (again, Ok(joined));
         }
     }
-    Ok(Covering {
+    Ok(WeldedCover {
         welded: welded.map_err(SchemeError::Model)?,
-        banded,
+        cover,
         whole_bands,
         tolerance,
     })
@@ -106,7 +106,7 @@ fn covering(
 /// a band strays however narrow; elsewhere (a band whose strip folds over its outline
 /// round a sharp corner however narrow, as on coarse or holed models) a larger bound
 /// changes nothing, and the net scheme's islands build.
-fn covering_fix(surface: &Triangles, why: &str) -> &'static str {
+fn cover_fix(surface: &Triangles, why: &str) -> &'static str {
     match (why.ends_with(STAYS_OFF), rims(surface).is_empty()) {
         (true, _) => "a larger --max-deviation may reach",
         (false, true) => "a larger --max-deviation does not change that: use --scheme net",
@@ -140,8 +140,8 @@ fn within_unsimplified(
     bound: f64,
     simplified: &[[DVec3; 3]],
     unsimplified: &[[DVec3; 3]],
-    cover: &dyn Fn(f64) -> Result<Covering, SchemeError>,
-) -> Result<(Covering, f64), SchemeError> {
+    cover: &dyn Fn(f64) -> Result<WeldedCover, SchemeError>,
+) -> Result<(WeldedCover, f64), SchemeError> {
     let spacing = bound / 3.0;
     // A bound that holds at every point, refined until settled against `within`.
     let beyond = |a: Soup, b: Soup, within: f64| {
@@ -153,12 +153,12 @@ fn within_unsimplified(
     let sampled =
         |a: Soup, b: Soup| both_ways(a, b, &|from, to| one_way_distance(from, to, spacing / 4.0));
     let to_model =
-        |covered: &Covering| beyond(&strip_soup(&covered.banded.strips), unsimplified, bound);
+        |covered: &WeldedCover| beyond(&strip_soup(&covered.cover.strips), unsimplified, bound);
     // A narrower try that finds no strips says why it was narrower.
     let narrowed = |tolerance: f64| {
         cover(tolerance).map_err(|e| match e {
             SchemeError::Model(why) => {
-                // `covering` names the mesh it covered "the model"; here it is the
+                // `welded_cover` names the mesh it covered "the model"; here it is the
                 // simplified one.
                 let why = why.replacen("of the model:", "of the simplified model:", 1);
                 SchemeError::Model(format!(
@@ -176,8 +176,8 @@ fn within_unsimplified(
     // Narrower tries, each by what the one before strayed beyond the bound (where the
     // finer samples find no point beyond it, the bound's own measure does): a band's
     // worst point moves with its width, so one narrowing may not be enough.
-    let strayed = |covered: &Covering, measured: f64| match sampled(
-        &strip_soup(&covered.banded.strips),
+    let strayed = |covered: &WeldedCover, measured: f64| match sampled(
+        &strip_soup(&covered.cover.strips),
         unsimplified,
     ) {
         finer if finer > bound => finer,
@@ -206,12 +206,12 @@ fn within_unsimplified(
     // Strips within `assured` of the simplified mesh keep the bound to the model as
     // given (the triangle inequality), even where the measured bound, which adds the
     // samples' reach, says a little more.
-    let kept = |covered: Covering, measured: f64| {
-        let measured = measured.min(covered.banded.deviation + simplification);
+    let kept = |covered: WeldedCover, measured: f64| {
+        let measured = measured.min(covered.cover.deviation + simplification);
         (covered, measured)
     };
     match last_try {
-        Some((covered, measured)) if covered.banded.deviation <= assured => {
+        Some((covered, measured)) if covered.cover.deviation <= assured => {
             return Ok(kept(covered, measured));
         }
         _ => {}
@@ -295,9 +295,9 @@ mod tests {
                 points: vec![square[0][0], square[0][1], square[0][2], square[1][2]],
                 triangles: vec![[0, 1, 2], [0, 2, 3]],
             }];
-            Ok(Covering {
+            Ok(WeldedCover {
                 welded: Welded::new(&strips).unwrap(),
-                banded: Banded { strips, deviation },
+                cover: Cover { strips, deviation },
                 whole_bands: false,
                 tolerance,
             })
