@@ -29,8 +29,8 @@ use common::build::{
     panels_of, read_manifest, read_simple_obj, shared_models, unfold, unfold_command, DxfCheck,
 };
 use unfold::config::Job;
-use unfold::mesh::EdgeId;
-use unfold::panel::{Covers, LabelKind};
+use unfold::mesh::{EdgeId, Mesh};
+use unfold::panel::{Covers, FlatPanel, LabelKind, Panel};
 
 // =======================================================================================
 // Helpers (the shared ones are in tests/common/build.rs)
@@ -116,17 +116,28 @@ fn every_sheet_passes_the_independent_check() {
 /// sheets, not how tightly they are packed (`tests/nesting.rs` and the bench check the
 /// true-shape layout of such models), and it keeps the suite quick.
 #[test]
-fn every_sheet_of_the_shared_models_passes_the_independent_check() {
-    let test = "every_sheet_of_the_shared_models_passes_the_independent_check";
+fn every_sheet_of_fertility_passes_the_independent_check() {
+    let test = "every_sheet_of_fertility_passes_the_independent_check";
+    check_shared_build(test, "fertility.obj");
+}
+
+/// The same on spot, a test of its own so that it runs beside fertility.
+#[test]
+fn every_sheet_of_spot_passes_the_independent_check() {
+    check_shared_build(
+        "every_sheet_of_spot_passes_the_independent_check",
+        "spot.obj",
+    );
+}
+
+fn check_shared_build(test: &str, name: &str) {
     if let Some(shared) = shared_models(test) {
-        for name in ["fertility.obj", "spot.obj"] {
-            check_build(
-                &shared.join(name),
-                "4ft",
-                DxfCheck::FirstAndLast,
-                &["--nester", "shelf"],
-            );
-        }
+        check_build(
+            &shared.join(name),
+            "4ft",
+            DxfCheck::FirstAndLast,
+            &["--nester", "shelf"],
+        );
     }
 }
 
@@ -278,10 +289,24 @@ fn face_scale_below_one_with_tabs_builds_valid_sheets() {
 /// `rel_tol`: how close (relative to the model size) partner holes must be on the
 /// band's plane: 1e-9 for exact geometry.
 fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64) {
-    let what = format!("{} at {size}, --holes {holes}", model.display());
     let tmp = TempDir::new().unwrap();
     let job = half_edge_job(model, size, holes, &tmp.path().join("out"));
-    let (mesh, connections, panels, flat) = panels_of(&job);
+    check_holes_of(&job, panels_of(&job), size_mm, rel_tol);
+}
+
+/// [`check_holes`] on the panels of `job` built already (a test that checks more of
+/// the same panels builds them once).
+fn check_holes_of(
+    job: &Job,
+    (mesh, connections, panels, flat): (Mesh, usize, Vec<Panel>, Vec<FlatPanel>),
+    size_mm: f64,
+    rel_tol: f64,
+) {
+    let holes = job.scheme.panel().holes;
+    let what = format!(
+        "{} at {size_mm} mm, --holes {holes}",
+        job.model_path.display()
+    );
     let frames = frames_of(&panels);
     let tol = rel_tol * size_mm;
     let r = 0.5 * job.scheme.panel().hole_diameter;
@@ -449,8 +474,11 @@ fn check_holes(model: &Path, size: &str, size_mm: f64, holes: u32, rel_tol: f64)
         }
     }
 
-    // The manifest reports the same holes and connections.
-    let outcome = unfold::run(&job).expect("the job runs");
+    // The manifest reports the same holes and connections. They do not depend on the
+    // layout: the shelf nester lays the sheets out quickest.
+    let mut counted = job.clone();
+    counted.nest.nester = unfold::nest::NesterName::Shelf;
+    let outcome = unfold::run(&counted).expect("the job runs");
     assert_eq!(outcome.manifest.counts.holes, total, "{what}: counts.holes");
     assert_eq!(
         outcome.manifest.counts.connections, connections,
@@ -489,8 +517,9 @@ fn holes_of_a_connection_meet_in_3d_on_near_planar_faces() {
     let fertility = shared.join("fertility.obj");
     let tmp = TempDir::new().unwrap();
     let job = half_edge_job(&fertility, "4ft", 2, &tmp.path().join("out"));
-    let (_mesh, _connections, panels, flat) = panels_of(&job);
-    for (fp, frames) in flat.iter().zip(frames_of(&panels)) {
+    let built = panels_of(&job);
+    let (_, _, panels, flat) = &built;
+    for (fp, frames) in flat.iter().zip(frames_of(panels)) {
         for (k, f) in frames.iter().enumerate() {
             assert!(
                 (f.x3.length() - 1.0).abs() < 1e-12
@@ -504,7 +533,7 @@ fn holes_of_a_connection_meet_in_3d_on_near_planar_faces() {
             );
         }
     }
-    check_holes(&fertility, "4ft", 1219.2, 2, 1e-9);
+    check_holes_of(&job, built, 1219.2, 1e-9);
 }
 
 // =======================================================================================
