@@ -17,7 +17,7 @@ use tempfile::TempDir;
 
 use common::build::{
     build, check_output, check_sheets, count, frames_of, golden_build, model, options, pipeline,
-    resolve, DxfCheck,
+    resolve, DxfCheck, Pipeline,
 };
 
 /// The winged-edge job for a project model.
@@ -70,7 +70,11 @@ fn a_panel_per_edge_and_every_sheet_checks_for_every_shift() {
 /// (a face corner): two panels (the edges meeting there), the same holes on both, at
 /// the same 3D points. Returns holes per connection.
 fn holes_per_connection(job: &unfold::Job, what: &str) -> BTreeMap<u32, usize> {
-    let p = pipeline(job);
+    holes_per_connection_of(&pipeline(job), what)
+}
+
+/// [`holes_per_connection`] on panels built already.
+fn holes_per_connection_of(p: &Pipeline, what: &str) -> BTreeMap<u32, usize> {
     let size = 300.0;
     let mut by_connection: BTreeMap<u32, BTreeMap<String, Vec<DVec3>>> = BTreeMap::new();
     for (flat, frames) in p.flat.iter().zip(frames_of(&p.panels)) {
@@ -130,8 +134,8 @@ fn every_corner_holds_fasteners_at_the_defaults() {
         let mut o = options("winged-edge", "1ft", 2, tmp.path());
         o.holes = None;
         let job = resolve(o, &model(name));
-        let counts = holes_per_connection(&job, name);
         let p = pipeline(&job);
+        let counts = holes_per_connection_of(&p, name);
         let corners: usize = p.mesh.faces().map(|f| p.mesh.face_degree(f)).sum();
         assert_eq!(counts.len(), corners, "{name}: every corner has holes");
         assert!(p.output.unfastened.is_empty(), "{name}");
