@@ -61,6 +61,19 @@ pub fn shared_model_files(shared: &Path) -> Vec<PathBuf> {
     models
 }
 
+/// The shared model files in name order, the first half or the second (`None`, with a
+/// message, when this checkout has no shared models): a test over every shared model
+/// split in two, so that the halves run on two cores.
+pub fn half_of_the_shared_models(test: &str, second: bool) -> Option<Vec<PathBuf>> {
+    let models = shared_model_files(&shared_models(test)?);
+    let half = models.len().div_ceil(2);
+    Some(if second {
+        models[half..].to_vec()
+    } else {
+        models[..half].to_vec()
+    })
+}
+
 // =======================================================================================
 // Running the binary
 // =======================================================================================
