@@ -66,16 +66,33 @@ fn sweep_model(model: &Path, dir: &Path) -> PathBuf {
 
 #[test]
 fn every_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
-    let tmp = TempDir::new().unwrap();
-    let mut models: Vec<PathBuf> = std::fs::read_dir(crate_dir().join("models"))
+    let models: Vec<PathBuf> = std::fs::read_dir(crate_dir().join("models"))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|x| x == "obj"))
         .collect();
-    if let Some(dir) = shared_models("every_model_scheme_kerf_and_mirror_builds") {
-        let shared = common::build::shared_model_files(&dir);
-        models.extend(shared.iter().map(|m| sweep_model(m, tmp.path())));
-    }
+    sweep(models, &TempDir::new().unwrap());
+}
+
+/// The same on the shared models, a test of its own so that it runs beside the
+/// project's models (each takes both cores only part of the time).
+#[test]
+fn every_shared_model_scheme_kerf_and_mirror_builds_or_refuses_without_a_panic() {
+    let tmp = TempDir::new().unwrap();
+    let Some(dir) = shared_models("every_shared_model_scheme_kerf_and_mirror_builds") else {
+        return;
+    };
+    let shared = common::build::shared_model_files(&dir);
+    sweep(
+        shared.iter().map(|m| sweep_model(m, tmp.path())).collect(),
+        &tmp,
+    );
+}
+
+/// Builds every model of `models` with every scheme, each with one of the kerf and
+/// mirror cases in turn, two runs at a time; checks that none panics and that most
+/// build.
+fn sweep(mut models: Vec<PathBuf>, tmp: &TempDir) {
     models.sort();
     let mut cases = Vec::new();
     for (m, model) in models.iter().enumerate() {
