@@ -16,3 +16,16 @@ pub struct NestOptions {
     /// Optional wall-clock cap on the improvement and squeeze phases.
     pub time_limit: Option<Duration>,
 }
+
+/// Quarter turns, no mirror, effort 5, seed 1 and no time limit: the search the
+/// nester's unit tests run.
+#[cfg(test)]
+pub(super) fn test_options() -> NestOptions {
+    NestOptions {
+        rotations: 4,
+        mirror: false,
+        effort: 5,
+        seed: 1,
+        time_limit: None,
+    }
+}

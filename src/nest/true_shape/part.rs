@@ -416,18 +416,9 @@ fn pose_discs(discs: &[Circle], transform: &Transformation, out: &mut Vec<Circle
 
 #[cfg(test)]
 mod tests {
+    use super::super::options::test_options as options;
     use super::*;
     use crate::nest::test_rectangle as rectangle;
-
-    fn options() -> NestOptions {
-        NestOptions {
-            rotations: 4,
-            mirror: false,
-            effort: 5,
-            seed: 1,
-            time_limit: None,
-        }
-    }
 
     /// The rotation of each square orientation, relative to the first, in quarter turns
     /// (and whether it is mirrored).

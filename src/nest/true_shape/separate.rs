@@ -531,20 +531,11 @@ impl Nester<'_> {
 #[cfg(test)]
 mod tests {
     use super::super::super::test_rectangle as rectangle;
-    use super::super::options::NestOptions;
+    use super::super::options::test_options as options;
     use super::super::part::prepare;
     use super::*;
     use crate::nest::SheetSpec;
 
-    fn options() -> NestOptions {
-        NestOptions {
-            rotations: 4,
-            mirror: false,
-            effort: 5,
-            seed: 1,
-            time_limit: None,
-        }
-    }
     /// Eight 80 mm squares on a 300 mm sheet, the middle row of two placed so that
     /// no 80 mm square is free; the ninth is alone on a second sheet. Squeezing it
     /// into the first needs the middle row rearranged.
