@@ -376,6 +376,33 @@ pub(crate) fn tetrahedron() -> Mesh {
     build_from_faces(p, &[[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]]).unwrap()
 }
 
+/// The corners of a cube of `side` with a corner at the origin (corner i at
+/// (i & 1, i >> 1 & 1, i >> 2 & 1) · `side`) and its faces, bottom, top, front, back,
+/// left, right, counter-clockwise seen from outside, for the unit tests.
+#[cfg(test)]
+pub(crate) fn cube_faces(side: f64) -> (Vec<DVec3>, [[u32; 4]; 6]) {
+    let corners = (0..8)
+        .map(|i| side * DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
+        .collect();
+    let faces = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [3, 2, 6, 7],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    (corners, faces)
+}
+
+/// A closed cube of `side` with a corner at the origin (see [`cube_faces`]), for the
+/// unit tests.
+#[cfg(test)]
+pub(crate) fn cube(side: f64) -> Mesh {
+    let (corners, faces) = cube_faces(side);
+    build_from_faces(corners, &faces).expect("cube builds")
+}
+
 /// Two triangles hinged on the edge (0,0,0)–(60,0,0) mm, for the schemes' unit tests:
 /// face 0 is (0,0,0), (30,−30,0), (60,0,0) in z = 0 (normal +z), face 1 is (0,0,0),
 /// (60,0,0), `apex`. The hinge is edge 2 (half-edge 4 runs (60,0,0) → (0,0,0) in face

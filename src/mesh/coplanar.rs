@@ -389,17 +389,7 @@ mod tests {
 
     /// A unit cube of 12 triangles.
     fn triangulated_cube() -> Mesh {
-        let p: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
-        let quads = [
-            [0u32, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
+        let (p, quads) = crate::mesh::build::cube_faces(1.0);
         let tris: Vec<[u32; 3]> = quads
             .iter()
             .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])

@@ -332,18 +332,7 @@ mod tests {
 
     /// A closed cube of side [`SIDE`], faces bottom, top, front, back, left, right.
     fn cube() -> Mesh {
-        let p = (0..8)
-            .map(|i| SIDE * DVec3::new((i & 1) as f64, (i >> 1 & 1) as f64, (i >> 2) as f64))
-            .collect();
-        let faces = [
-            [0u32, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [3, 2, 6, 7],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        build_from_faces(p, &faces).unwrap()
+        crate::mesh::build::cube(SIDE)
     }
 
     /// Flat squares of side [`SIDE`] in z = 0, face k on cell `cells[k]` (column, row).

@@ -589,7 +589,7 @@ mod tests {
     use crate::scheme::rigid::cutback::rigid_panels;
 
     fn cube() -> Mesh {
-        crate::scheme::rigid::cutback::cube(200.0)
+        crate::mesh::build::cube(200.0)
     }
 
     #[test]

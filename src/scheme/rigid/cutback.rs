@@ -909,34 +909,10 @@ fn prism_overlap(a: &Prism, b: &Prism) -> f64 {
     }
 }
 
-/// A cube of `side` mm with a corner at the origin, for the rigid modules' unit tests.
-#[cfg(test)]
-pub(super) fn cube(side: f64) -> Mesh {
-    let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z) * side;
-    let positions = vec![
-        p(0., 0., 0.),
-        p(1., 0., 0.),
-        p(1., 1., 0.),
-        p(0., 1., 0.),
-        p(0., 0., 1.),
-        p(1., 0., 1.),
-        p(1., 1., 1.),
-        p(0., 1., 1.),
-    ];
-    let faces: [[u32; 4]; 6] = [
-        [0, 3, 2, 1],
-        [4, 5, 6, 7],
-        [0, 1, 5, 4],
-        [1, 2, 6, 5],
-        [2, 3, 7, 6],
-        [3, 0, 4, 7],
-    ];
-    crate::mesh::build_from_faces(positions, &faces).expect("cube builds")
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mesh::build::cube;
 
     #[test]
     fn cut_backs_follow_the_angle() {

@@ -316,7 +316,7 @@ fn too_thick(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scheme::rigid::cutback::cube;
+    use crate::mesh::build::cube;
 
     /// Options every scheme takes, at `face_scale`, on no sheet.
     fn panel(face_scale: f64) -> PanelOptions {
