@@ -6,8 +6,9 @@
 
 use std::collections::VecDeque;
 
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 
+use super::geometry::PlaneFrame;
 use super::{build_mesh, FaceId, HalfedgeId, Mesh, Polygons, VertexId};
 
 /// A mesh's flat regions as a mesh of their own.
@@ -73,7 +74,8 @@ fn grow_regions(mesh: &Mesh, rules: &RegionRules<'_>) -> Vec<u32> {
         }
         let k = count;
         count += 1;
-        let plane = Plane::of(mesh, seed);
+        // A region's plane is its first face's.
+        let plane = mesh.face_frame(seed);
         let mut corners: Vec<DVec2> = mesh.face_positions(seed).map(|p| plane.flat(p)).collect();
         let mut size = 1;
         growth.join(mesh, seed, k);
@@ -81,7 +83,7 @@ fn grow_regions(mesh: &Mesh, rules: &RegionRules<'_>) -> Vec<u32> {
             if growth.region[f.index()] != u32::MAX || size >= rules.max_faces {
                 continue;
             }
-            if !plane.holds(mesh, f, rules.tolerance) || !growth.keeps_disk(mesh, f, k) {
+            if !holds(&plane, mesh, f, rules.tolerance) || !growth.keeps_disk(mesh, f, k) {
                 continue;
             }
             let mut grown = corners.clone();
@@ -150,37 +152,13 @@ impl Growth {
     }
 }
 
-/// A region's plane: its first face's centre and normal, with axes.
-struct Plane {
-    origin: DVec3,
-    normal: DVec3,
-    x: DVec3,
-    y: DVec3,
-}
-
-impl Plane {
-    fn of(mesh: &Mesh, f: FaceId) -> Plane {
-        let normal = mesh.face_normal(f);
-        let x = normal.any_orthonormal_vector();
-        Plane {
-            origin: mesh.face_centre(f),
-            normal,
-            x,
-            y: normal.cross(x),
-        }
-    }
-
-    fn flat(&self, p: DVec3) -> DVec2 {
-        DVec2::new((p - self.origin).dot(self.x), (p - self.origin).dot(self.y))
-    }
-
-    /// Face `f` faces the same way and its corners lie within `tolerance` of the plane.
-    fn holds(&self, mesh: &Mesh, f: FaceId, tolerance: f64) -> bool {
-        mesh.face_normal(f).dot(self.normal) > 0.0
-            && mesh
-                .face_positions(f)
-                .all(|p| (p - self.origin).dot(self.normal).abs() <= tolerance)
-    }
+/// Face `f` faces the same way as `plane` (a region's) and its corners lie within
+/// `tolerance` of it.
+fn holds(plane: &PlaneFrame, mesh: &Mesh, f: FaceId, tolerance: f64) -> bool {
+    mesh.face_normal(f).dot(plane.normal) > 0.0
+        && mesh
+            .face_positions(f)
+            .all(|p| (p - plane.origin).dot(plane.normal).abs() <= tolerance)
 }
 
 /// Region `k`'s outline: its boundary half-edges in order round it, from the lowest.
@@ -376,6 +354,8 @@ fn merged_mesh(
 
 #[cfg(test)]
 mod tests {
+    use glam::DVec3;
+
     use super::*;
     use crate::mesh::build_from_faces;
 

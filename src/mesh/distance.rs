@@ -72,6 +72,34 @@ pub fn may_reach(bound: f64, best: f64, slack: f64) -> bool {
     bound <= best + slack
 }
 
+/// Items filed by grid cell in a compressed table: `cells_of(i)` lists the cells
+/// item `i` of `count` covers. Gives `starts`, one longer than `cells`, and `entries`:
+/// cell `c` holds the items `entries[starts[c]..starts[c + 1]]`, in increasing order.
+pub fn cell_table<C: IntoIterator<Item = usize>>(
+    cells: usize,
+    count: usize,
+    cells_of: impl Fn(usize) -> C,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut starts = vec![0u32; cells + 1];
+    for i in 0..count {
+        for c in cells_of(i) {
+            starts[c + 1] += 1;
+        }
+    }
+    for c in 1..starts.len() {
+        starts[c] += starts[c - 1];
+    }
+    let mut fill = starts.clone();
+    let mut entries = vec![0u32; starts[cells] as usize];
+    for i in 0..count {
+        for c in cells_of(i) {
+            entries[fill[c] as usize] = i as u32;
+            fill[c] += 1;
+        }
+    }
+    (starts, entries)
+}
+
 /// Triangles bucketed by a uniform grid, for nearest-distance queries.
 pub struct TriangleGrid<'a> {
     triangles: &'a [[DVec3; 3]],
@@ -116,42 +144,24 @@ impl<'a> TriangleGrid<'a> {
         let dims = [size.x, size.y, size.z].map(|s| ((s / cell).floor() as usize + 1).min(257));
         let index = |p: DVec3, k: usize| cell_index(p, k, lo, cell, dims);
         let cells = dims[0] * dims[1] * dims[2];
-        let mut counts = vec![0u32; cells + 1];
-        let mut ranges = Vec::with_capacity(triangles.len());
-        for &(tlo, thi) in &boxes {
-            let range = [0, 1, 2].map(|k| (index(tlo, k), index(thi, k)));
-            for z in range[2].0..=range[2].1 {
-                for y in range[1].0..=range[1].1 {
-                    for x in range[0].0..=range[0].1 {
-                        counts[x + dims[0] * (y + dims[1] * z) + 1] += 1;
-                    }
-                }
-            }
-            ranges.push(range);
-        }
-        for i in 1..counts.len() {
-            counts[i] += counts[i - 1];
-        }
-        let mut fill = counts.clone();
-        let mut entries = vec![0u32; counts[cells] as usize];
-        for (t, range) in ranges.iter().enumerate() {
-            for z in range[2].0..=range[2].1 {
-                for y in range[1].0..=range[1].1 {
-                    for x in range[0].0..=range[0].1 {
-                        let c = x + dims[0] * (y + dims[1] * z);
-                        entries[fill[c] as usize] = t as u32;
-                        fill[c] += 1;
-                    }
-                }
-            }
-        }
+        let ranges: Vec<[(usize, usize); 3]> = boxes
+            .iter()
+            .map(|&(tlo, thi)| [0, 1, 2].map(|k| (index(tlo, k), index(thi, k))))
+            .collect();
+        let (starts, entries) = cell_table(cells, ranges.len(), |t| {
+            let [xs, ys, zs] = ranges[t];
+            (zs.0..=zs.1).flat_map(move |z| {
+                (ys.0..=ys.1)
+                    .flat_map(move |y| (xs.0..=xs.1).map(move |x| x + dims[0] * (y + dims[1] * z)))
+            })
+        });
         TriangleGrid {
             triangles,
             boxes,
             lo,
             cell,
             dims,
-            starts: counts,
+            starts,
             entries,
         }
     }

@@ -1,6 +1,49 @@
 //! Small geometric measures on polygons in 3D.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
+
+/// A plane with axes, to carry 3D points on it into 2D and back.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlaneFrame {
+    /// The point at (0, 0).
+    pub origin: DVec3,
+    /// Unit normal.
+    pub normal: DVec3,
+    /// Unit x axis, in the plane.
+    pub x: DVec3,
+    /// Unit y axis, normal × x.
+    pub y: DVec3,
+}
+
+impl PlaneFrame {
+    /// The frame at `origin` of the plane of unit `normal`, with `x` (a unit vector in
+    /// the plane) as its x axis.
+    pub fn with_x(origin: DVec3, normal: DVec3, x: DVec3) -> Self {
+        PlaneFrame {
+            origin,
+            normal,
+            x,
+            y: normal.cross(x),
+        }
+    }
+
+    /// The frame at `origin` of the plane of unit `normal`, with any x axis: for
+    /// shapes whose 2D orientation does not matter.
+    pub fn new(origin: DVec3, normal: DVec3) -> Self {
+        Self::with_x(origin, normal, normal.any_orthonormal_vector())
+    }
+
+    /// `p` projected onto the plane, in the frame's 2D coordinates.
+    pub fn flat(&self, p: DVec3) -> DVec2 {
+        let d = p - self.origin;
+        DVec2::new(d.dot(self.x), d.dot(self.y))
+    }
+
+    /// The point of the plane at 2D coordinates `q`.
+    pub fn lift(&self, q: DVec2) -> DVec3 {
+        self.origin + q.x * self.x + q.y * self.y
+    }
+}
 
 /// Half the sum of the corner cross products: for a planar polygon, its length is the
 /// area and its direction the normal (right-hand rule), concave polygons included.

@@ -278,6 +278,12 @@ impl Mesh {
         self.face_vector_area(f).normalize_or_zero()
     }
 
+    /// A face's plane with axes, its origin at the face centre (the frame the schemes
+    /// draw a face's band and connectors in).
+    pub fn face_frame(&self, f: FaceId) -> super::geometry::PlaneFrame {
+        super::geometry::PlaneFrame::new(self.face_centre(f), self.face_normal(f))
+    }
+
     /// The area of a face (of its vector area; exact for planar faces).
     pub fn face_area(&self, f: FaceId) -> f64 {
         self.face_vector_area(f).length()

@@ -10,6 +10,7 @@ use i_overlay::float::overlay::{FloatOverlay, OverlayOptions};
 use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::OutlineStyle;
 
+use crate::mesh::geometry::PlaneFrame;
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::OptionDefault;
 use crate::panel::{Label, LabelKind, Loops, Name};
@@ -255,55 +256,18 @@ impl FaceFlaps {
     }
 }
 
-/// A 2D frame in a face's plane, centred on the face centre.
-#[derive(Clone, Copy, Debug)]
-pub struct FaceFrame {
-    /// Face centre.
-    pub centre: DVec3,
-    /// In-plane axes.
-    pub ex: DVec3,
-    /// In-plane axes.
-    pub ey: DVec3,
-}
-
-impl FaceFrame {
-    /// The frame of face `f`.
-    pub fn new(mesh: &Mesh, f: FaceId) -> Self {
-        let normal = mesh.face_normal(f);
-        let ex = normal.any_orthonormal_vector();
-        Self {
-            centre: mesh.face_centre(f),
-            ex,
-            ey: normal.cross(ex),
-        }
-    }
-
-    /// Into the plane (the face centre is the origin).
-    pub fn to2(&self, p: DVec3) -> DVec2 {
-        DVec2::new(
-            (p - self.centre).dot(self.ex),
-            (p - self.centre).dot(self.ey),
-        )
-    }
-
-    /// Back to 3D.
-    pub fn to3(&self, q: DVec2) -> DVec3 {
-        self.centre + q.x * self.ex + q.y * self.ey
-    }
-}
-
 /// The face band of `f` in 3D and in its frame. The band corners are projected onto
 /// the face's plane (through its centre, normal to its vector area), so every flap is
 /// an exactly planar facet and the holes of a corner lie on both flaps even when the
 /// face is planar only within the tolerance; on a planar face nothing moves.
-pub fn band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> (Vec<DVec3>, Vec<DVec2>, FaceFrame) {
-    let frame = FaceFrame::new(mesh, f);
-    let normal = frame.ex.cross(frame.ey);
+pub fn band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> (Vec<DVec3>, Vec<DVec2>, PlaneFrame) {
+    let frame = mesh.face_frame(f);
+    let normal = frame.x.cross(frame.y);
     let band: Vec<DVec3> = face_band(mesh, f, options.panel.face_scale)
         .into_iter()
-        .map(|p| p - (p - frame.centre).dot(normal) * normal)
+        .map(|p| p - (p - frame.origin).dot(normal) * normal)
         .collect();
-    let flat = band.iter().map(|&p| frame.to2(p)).collect();
+    let flat = band.iter().map(|&p| frame.flat(p)).collect();
     (band, flat, frame)
 }
 

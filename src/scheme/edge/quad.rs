@@ -131,11 +131,11 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
     let (n, panel) = (face.b.len(), &options.panel);
     let mut parts = FaceFlaps::new(&band3, flaps.iter().map(|f| f.len() - 2).sum());
     for flap in &flaps {
-        parts.push_flap(flap.iter().skip(2).map(|&q| frame.to3(q)));
+        parts.push_flap(flap.iter().skip(2).map(|&q| frame.lift(q)));
     }
     for (k, corner) in corners.into_iter().enumerate() {
         let prev = (k + n - 1) % n;
-        parts.set_corner_label(k, frame.to3(corner.centre));
+        parts.set_corner_label(k, frame.lift(corner.centre));
         parts.grown += usize::from(corner.depth > options.flap_scale);
         let pins = corner.pins;
         parts.reduced += usize::from((pins.len() as u32) < panel.holes);
@@ -146,7 +146,7 @@ fn flaps_in_band(mesh: &Mesh, f: FaceId, options: &EdgeOptions) -> FaceFlaps {
         }
         let connection = half_edges[k].0;
         for pin in pins {
-            parts.add_hole([prev, k], frame.to3(pin), connection);
+            parts.add_hole([prev, k], frame.lift(pin), connection);
         }
     }
     parts.shrink_to_fit();

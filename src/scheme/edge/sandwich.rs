@@ -29,9 +29,7 @@ use i_overlay::mesh::float::outline::offset::OutlineOffset;
 use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
 use rayon::prelude::*;
 
-use super::flaps::{
-    bend_id_label, bezier, corners_of, flap_labels, EdgeOptions, FaceFlaps, FaceFrame,
-};
+use super::flaps::{bend_id_label, bezier, corners_of, flap_labels, EdgeOptions, FaceFlaps};
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::panel::{Covers, Hole, IdKind, Label, Loops, Name, Panel, Panels, Source};
 use crate::plane::{contains, signed_area};
@@ -194,7 +192,7 @@ const LAP_ROUNDS: usize = 8;
 /// so cut off its fold is left out, and then from the other layer too, so the two
 /// layers still cover the same ground.
 fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
-    let frame = FaceFrame::new(mesh, f);
+    let frame = mesh.face_frame(f);
     let n = part.corners();
     let band = part.band();
     let flat: Vec<Vec<DVec2>> = (0..n)
@@ -202,7 +200,7 @@ fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
             [band[k], band[(k + 1) % n]]
                 .iter()
                 .chain(part.flap_rest(k))
-                .map(|&p| frame.to2(p))
+                .map(|&p| frame.flat(p))
                 .collect()
         })
         .collect();
@@ -250,11 +248,11 @@ fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
                     let (a, b) = (band[k], band[(k + 1) % n]);
                     let holes = part
                         .flap_holes(k)
-                        .filter(|(p, _)| contains(&outline, frame.to2(*p)))
+                        .filter(|(p, _)| contains(&outline, frame.flat(*p)))
                         .collect();
                     let outline = [a.lerp(b, fold[0]), a.lerp(b, fold[1])]
                         .into_iter()
-                        .chain(outline[2..].iter().map(|&q| frame.to3(q)))
+                        .chain(outline[2..].iter().map(|&q| frame.lift(q)))
                         .collect();
                     LayerFlap {
                         outline,
@@ -267,7 +265,7 @@ fn face_layers(mesh: &Mesh, f: FaceId, part: &FaceFlaps) -> FaceLayers {
         .collect();
     FaceLayers {
         flaps,
-        normal: frame.ex.cross(frame.ey),
+        normal: frame.x.cross(frame.y),
         dropped: gone.iter().map(|g| signed_area(g).abs()).sum(),
     }
 }

@@ -223,10 +223,10 @@ fn face_flaps_at(
 
     let mut parts = FaceFlaps::new(&band3, rest.iter().map(Vec::len).sum());
     for r in &rest {
-        parts.push_flap(r.iter().map(|&q| frame.to3(q)));
+        parts.push_flap(r.iter().map(|&q| frame.lift(q)));
     }
     for k in 0..n {
-        parts.set_corner_label(k, frame.to3(0.5 * (at(k) + inner(k))));
+        parts.set_corner_label(k, frame.lift(0.5 * (at(k) + inner(k))));
     }
     let mut placed_at_corner = vec![0usize; n];
     let mut short_at_corner = vec![false; n];
@@ -239,7 +239,7 @@ fn face_flaps_at(
         placed_at_corner[*corner] += pins.len();
         let connection = half_edges[*corner].0;
         for pin in pins {
-            parts.add_hole([*e1, *e2], frame.to3(pin), connection);
+            parts.add_hole([*e1, *e2], frame.lift(pin), connection);
         }
     }
     if options.panel.holes > 0 {

@@ -13,7 +13,8 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::{DVec2, DVec3};
 
-use crate::mesh::distance::TriangleGrid;
+use crate::mesh::distance::{cell_table, TriangleGrid};
+use crate::mesh::geometry::PlaneFrame;
 use crate::mesh::{FaceId, HalfedgeId, Mesh, VertexId};
 
 /// Two parts may overlap by this much (mm): rounding, not material.
@@ -103,7 +104,7 @@ pub fn rigid_panels(
     thickness: f64,
 ) -> Result<RigidPanels, RigidError> {
     let insets = edge_insets(mesh, thickness);
-    let frames: Vec<FaceFrame> = mesh.faces().map(|f| FaceFrame::of(mesh, f)).collect();
+    let frames: Vec<PlaneFrame> = mesh.faces().map(|f| face_frame(mesh, f)).collect();
     let mut outlines = Vec::with_capacity(mesh.face_count());
     for f in mesh.faces() {
         let outline = inset_outline(mesh, f, &frames[f.0 as usize], &insets)
@@ -137,7 +138,7 @@ pub fn rigid_panels(
             .iter()
             .zip(&frames)
             .map(|(o, frame)| RigidOutline {
-                points: o.points.iter().map(|&p| frame.to_3d(p)).collect(),
+                points: o.points.iter().map(|&p| frame.lift(p)).collect(),
                 along: o.along.clone(),
             })
             .collect(),
@@ -188,38 +189,13 @@ fn edge_insets(mesh: &Mesh, thickness: f64) -> Vec<f64> {
     insets
 }
 
-/// A face's plane with axes: 2D points on it and back.
-#[derive(Clone, Copy, Debug)]
-struct FaceFrame {
-    origin: DVec3,
-    x: DVec3,
-    y: DVec3,
-    normal: DVec3,
-}
-
-impl FaceFrame {
-    fn of(mesh: &Mesh, f: FaceId) -> FaceFrame {
-        let normal = mesh.face_normal(f);
-        let origin = mesh.face_centre(f);
-        let h = mesh.face_half_edge(f);
-        let side = mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h));
-        let x = side.reject_from_normalized(normal).normalize_or_zero();
-        FaceFrame {
-            origin,
-            x,
-            y: normal.cross(x),
-            normal,
-        }
-    }
-
-    fn to_2d(self, p: DVec3) -> DVec2 {
-        let d = p - self.origin;
-        DVec2::new(d.dot(self.x), d.dot(self.y))
-    }
-
-    fn to_3d(self, p: DVec2) -> DVec3 {
-        self.origin + p.x * self.x + p.y * self.y
-    }
+/// A face's plane with axes, x along its first side.
+fn face_frame(mesh: &Mesh, f: FaceId) -> PlaneFrame {
+    let normal = mesh.face_normal(f);
+    let h = mesh.face_half_edge(f);
+    let side = mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h));
+    let x = side.reject_from_normalized(normal).normalize_or_zero();
+    PlaneFrame::with_x(mesh.face_centre(f), normal, x)
 }
 
 /// An outline in its face's frame.
@@ -231,12 +207,17 @@ struct FlatOutline {
 
 /// Face `f`'s outline with each side moved inward by its inset, corners where the
 /// moved sides meet; `None` when a side vanishes or the outline crosses itself.
-fn inset_outline(mesh: &Mesh, f: FaceId, frame: &FaceFrame, insets: &[f64]) -> Option<FlatOutline> {
+fn inset_outline(
+    mesh: &Mesh,
+    f: FaceId,
+    frame: &PlaneFrame,
+    insets: &[f64],
+) -> Option<FlatOutline> {
     let sides: Vec<HalfedgeId> = mesh.face_half_edges(f).collect();
     let n = sides.len();
     let corner: Vec<DVec2> = sides
         .iter()
-        .map(|&h| frame.to_2d(mesh.position(mesh.origin(h))))
+        .map(|&h| frame.flat(mesh.position(mesh.origin(h))))
         .collect();
     let dir: Vec<DVec2> = (0..n)
         .map(|k| (corner[(k + 1) % n] - corner[k]).normalize_or_zero())
@@ -292,7 +273,7 @@ struct Corner<'a> {
     mesh: &'a Mesh,
     v: VertexId,
     thickness: f64,
-    frames: &'a [FaceFrame],
+    frames: &'a [PlaneFrame],
     solid: &'a Solid,
     /// The solid's triangles, for how far a point lies outside it.
     nearest: &'a TriangleGrid<'a>,
@@ -400,7 +381,7 @@ impl Corner<'_> {
             }
             let frame = &self.frames[faces[i].0 as usize];
             for &p in &cut[i].points {
-                let q = frame.to_3d(p) - t * frame.normal;
+                let q = frame.lift(p) - t * frame.normal;
                 // Below every face plane at the vertex is inside the model there; only
                 // the other points need the whole surface's word.
                 let below_all = faces.iter().all(|g| {
@@ -473,7 +454,6 @@ impl Solid {
                 (k.y.max(0.0) as usize).min(dims[1] - 1),
             ]
         };
-        let mut starts = vec![0u32; dims[0] * dims[1] + 1];
         let ranges: Vec<([usize; 2], [usize; 2])> = triangles
             .iter()
             .map(|t| {
@@ -481,27 +461,10 @@ impl Solid {
                 (index(a), index(b))
             })
             .collect();
-        for &(a, b) in &ranges {
-            for y in a[1]..=b[1] {
-                for x in a[0]..=b[0] {
-                    starts[x + dims[0] * y + 1] += 1;
-                }
-            }
-        }
-        for k in 1..starts.len() {
-            starts[k] += starts[k - 1];
-        }
-        let mut fill = starts.clone();
-        let mut entries = vec![0u32; *starts.last().unwrap_or(&0) as usize];
-        for (t, &(a, b)) in ranges.iter().enumerate() {
-            for y in a[1]..=b[1] {
-                for x in a[0]..=b[0] {
-                    let c = x + dims[0] * y;
-                    entries[fill[c] as usize] = t as u32;
-                    fill[c] += 1;
-                }
-            }
-        }
+        let (starts, entries) = cell_table(dims[0] * dims[1], ranges.len(), |t| {
+            let (a, b) = ranges[t];
+            (a[1]..=b[1]).flat_map(move |y| (a[0]..=b[0]).map(move |x| x + dims[0] * y))
+        });
         Solid {
             triangles,
             lo,
@@ -572,12 +535,12 @@ struct CornerFrame {
 }
 
 impl CornerFrame {
-    fn of(mesh: &Mesh, f: FaceId, v: VertexId, frame: &FaceFrame) -> Option<CornerFrame> {
+    fn of(mesh: &Mesh, f: FaceId, v: VertexId, frame: &PlaneFrame) -> Option<CornerFrame> {
         let out = mesh.face_half_edges(f).find(|&h| mesh.origin(h) == v)?;
         let into = mesh.prev(out);
-        let at = frame.to_2d(mesh.position(v));
-        let onward = frame.to_2d(mesh.position(mesh.dest(out))) - at;
-        let back = frame.to_2d(mesh.position(mesh.origin(into))) - at;
+        let at = frame.flat(mesh.position(v));
+        let onward = frame.flat(mesh.position(mesh.dest(out))) - at;
+        let back = frame.flat(mesh.position(mesh.origin(into))) - at;
         let shorter = onward.length().min(back.length());
         let (onward, back) = (onward.normalize_or_zero(), back.normalize_or_zero());
         let inward = (onward + back).normalize_or_zero();
@@ -616,7 +579,7 @@ fn cut_corner(
     mesh: &Mesh,
     f: FaceId,
     corner: &CornerFrame,
-    frame: &FaceFrame,
+    frame: &PlaneFrame,
     outline: &FlatOutline,
     r: f64,
 ) -> Option<FlatOutline> {
@@ -643,7 +606,7 @@ fn cut_corner(
     let dir: Vec<DVec2> = sides
         .iter()
         .map(|&h| {
-            (frame.to_2d(mesh.position(mesh.dest(h))) - frame.to_2d(mesh.position(mesh.origin(h))))
+            (frame.flat(mesh.position(mesh.dest(h))) - frame.flat(mesh.position(mesh.origin(h))))
                 .normalize_or_zero()
         })
         .collect();
@@ -752,7 +715,7 @@ fn keep_between(
 /// thinner than two thicknesses).
 fn check_apart(
     thickness: f64,
-    frames: &[FaceFrame],
+    frames: &[PlaneFrame],
     outlines: &[FlatOutline],
 ) -> Result<(), RigidError> {
     let prisms: Vec<Vec<Prism>> = outlines
@@ -802,8 +765,8 @@ pub(super) struct Prism {
 }
 
 /// An outline as convex prisms: itself when convex, else its triangles.
-fn prisms_of(frame: &FaceFrame, outline: &FlatOutline, thickness: f64) -> Vec<Prism> {
-    let outer: Vec<DVec3> = outline.points.iter().map(|&p| frame.to_3d(p)).collect();
+fn prisms_of(frame: &PlaneFrame, outline: &FlatOutline, thickness: f64) -> Vec<Prism> {
+    let outer: Vec<DVec3> = outline.points.iter().map(|&p| frame.lift(p)).collect();
     if is_convex(&outline.points) {
         return vec![Prism::new(outer, frame.normal, thickness)];
     }
@@ -841,14 +804,9 @@ pub(super) fn outline_prisms(outline: &RigidOutline, normal: DVec3, thickness: f
         .points
         .get(1)
         .map_or(DVec3::X, |&p| (p - origin).normalize_or_zero());
-    let frame = FaceFrame {
-        origin,
-        x,
-        y: normal.cross(x),
-        normal,
-    };
+    let frame = PlaneFrame::with_x(origin, normal, x);
     let flat = FlatOutline {
-        points: outline.points.iter().map(|&p| frame.to_2d(p)).collect(),
+        points: outline.points.iter().map(|&p| frame.flat(p)).collect(),
         along: outline.along.clone(),
     };
     prisms_of(&frame, &flat, thickness)
@@ -994,7 +952,7 @@ mod tests {
 
     #[test]
     fn separating_axes_measure_overlap() {
-        let frame = FaceFrame {
+        let frame = PlaneFrame {
             origin: DVec3::ZERO,
             x: DVec3::X,
             y: DVec3::Y,
