@@ -142,34 +142,6 @@ pub struct Counts {
     pub partner_ids_left_out: usize,
 }
 
-/// Lengths of laser paths (mm).
-#[derive(Clone, Debug, Serialize)]
-pub struct Lengths {
-    /// Cut.
-    pub cut: f64,
-    /// Score: the SCORE layer (mountain folds as the sheets lie, and rulings).
-    pub score: f64,
-    /// Score: the SCORE-VALLEY layer (valley folds as the sheets lie).
-    pub score_valley: f64,
-    /// Engrave.
-    pub engrave: f64,
-    /// Travel with the beam off, paths in the order the files give them.
-    pub travel: f64,
-}
-
-impl Lengths {
-    /// The manifest's record of measured lengths, rounded.
-    pub fn of(lengths: &super::Lengths) -> Lengths {
-        Lengths {
-            cut: round4(lengths.cut),
-            score: round4(lengths.score),
-            score_valley: round4(lengths.score_valley),
-            engrave: round4(lengths.engrave),
-            travel: round4(lengths.travel),
-        }
-    }
-}
-
 /// The laser time estimate.
 #[derive(Clone, Debug, Serialize)]
 pub struct Laser {
@@ -206,8 +178,8 @@ pub struct SheetEntry {
     pub panels: usize,
     /// Panel area / sheet area.
     pub fill: f64,
-    /// Its laser path lengths.
-    pub lengths: Lengths,
+    /// Its laser path lengths, rounded.
+    pub lengths: super::Lengths,
     /// Its estimated laser time (seconds).
     pub time_s: f64,
 }
@@ -260,8 +232,8 @@ pub struct Manifest {
     pub panel_area: f64,
     /// panel_area / (sheets × sheet area).
     pub utilization: f64,
-    /// Laser path lengths.
-    pub lengths: Lengths,
+    /// Laser path lengths, rounded.
+    pub lengths: super::Lengths,
     /// The laser time estimate.
     pub laser: Laser,
     /// Largest developability error of any panel (mm).

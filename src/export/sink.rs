@@ -3,8 +3,10 @@
 //! and the one way a length is written.
 
 use glam::DVec2;
+use serde::Serialize;
 
 use crate::panel::FoldKind;
+use crate::record::round4;
 
 /// The kinds of laser geometry, in the order a sheet is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -144,14 +146,15 @@ pub trait SheetSink {
     fn circle(&mut self, kind: Kind, center: DVec2, radius: f64);
 }
 
-/// Lengths of what a sheet (or a run) draws, per kind (mm).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// Lengths of what a sheet (or a run) draws, per kind (mm), as measured and, rounded,
+/// as the manifest records them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Lengths {
     /// Cut length.
     pub cut: f64,
-    /// Score length of mountain folds (as the sheets lie) and rulings.
+    /// Score length of mountain folds (as the sheets lie) and rulings: the SCORE layer.
     pub score: f64,
-    /// Score length of valley folds (as the sheets lie).
+    /// Score length of valley folds (as the sheets lie): the SCORE-VALLEY layer.
     pub score_valley: f64,
     /// Engrave length.
     pub engrave: f64,
@@ -159,10 +162,23 @@ pub struct Lengths {
     /// next, in the order they were drawn.
     pub travel: f64,
     /// Where the last path drawn ended.
+    #[serde(skip)]
     pub last_end: Option<DVec2>,
 }
 
 impl Lengths {
+    /// The lengths rounded to 4 decimals, as the manifest records them.
+    pub fn rounded(&self) -> Lengths {
+        Lengths {
+            cut: round4(self.cut),
+            score: round4(self.score),
+            score_valley: round4(self.score_valley),
+            engrave: round4(self.engrave),
+            travel: round4(self.travel),
+            last_end: self.last_end,
+        }
+    }
+
     /// The beam moves to `start` and leaves at `end`.
     fn run(&mut self, start: DVec2, end: DVec2) {
         if let Some(at) = self.last_end {

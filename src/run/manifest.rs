@@ -101,7 +101,7 @@ pub(super) fn build_manifest(
         nesting: nested.nesting.clone(),
         panel_area: round4(panel_area),
         utilization: round4(panel_area / (layout.sheets as f64 * sheet.width * sheet.height)),
-        lengths: manifest::Lengths::of(&lengths),
+        lengths: lengths.rounded(),
         laser,
         scheme_sections: output.manifest.clone(),
         max_developability_error: manifest::round_nm(

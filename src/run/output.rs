@@ -246,7 +246,7 @@ fn draw_one_sheet(
         files: sheet_files.iter().map(|(n, _)| n.clone()).collect(),
         panels: on_sheet.len(),
         fill: round4(area / (sheet.width * sheet.height)),
-        lengths: manifest::Lengths::of(&lengths),
+        lengths: lengths.rounded(),
         time_s: round4(job.speeds.seconds(&lengths)),
     };
     DrawnSheet {
