@@ -1,6 +1,7 @@
 //! A job's panels, 3D ([`Panels`]) and flat ([`FlatPanels`]), each in one arena: one
 //! buffer per kind of item and a small head per panel saying where its items start.
-//! The two arenas are laid out alike, side by side here, each knowing its own fields.
+//! Both are one generic [`PanelArena`] over buffers declared by `buffers!`; each
+//! knows only how its panels map onto its buffers.
 
 use glam::{DVec2, DVec3};
 
@@ -10,56 +11,134 @@ use super::loops::LoopsRef;
 use super::shape::{FlatHole, FlatLabel, FlatPanel, FlatPanelRef, Fold, Hole, Panel, PanelRef};
 use super::source::Source;
 
-/// Where one panel's items start in each buffer of a [`Panels`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct PanelStarts {
-    vertices: u32,
-    facet_indices: u32,
-    facet_ends: u32,
-    holes: u32,
-    labels: u32,
+/// An arena's buffers, one per kind of item, grown, measured and cut into panels
+/// together: the `N` buffers behind a [`PanelArena`].
+pub trait Buffers<const N: usize>: Default {
+    /// One panel's items in each buffer.
+    type Slices<'a>
+    where
+        Self: 'a;
+    /// The length of every buffer: where the next panel's items start.
+    ///
+    /// # Panics
+    /// When a buffer has passed 2³² items.
+    fn lens(&self) -> [u32; N];
+    /// The items from `start` to `end` in each buffer.
+    fn slices(&self, start: [u32; N], end: [u32; N]) -> Self::Slices<'_>;
+    /// Appends one panel's items.
+    fn extend(&mut self, items: Self::Slices<'_>);
+    /// Appends all of `other`'s items.
+    fn append(&mut self, other: &Self);
+    /// Gives back spare capacity.
+    fn shrink_to_fit(&mut self);
 }
 
-/// What a [`Panels`] keeps of one panel beside its buffers.
+/// Declares an arena's buffers (one `Vec` per kind of item), a struct of one panel's
+/// slices of them, and their [`Buffers`] implementation, field by field.
+macro_rules! buffers {
+    ($(#[$doc:meta])* $name:ident, $slices:ident, $n:literal { $($field:ident: $item:ty,)* }) => {
+        $(#[$doc])*
+        #[derive(Clone, Debug, Default, PartialEq)]
+        pub struct $name {
+            $($field: Vec<$item>,)*
+        }
+
+        /// One panel's items in each buffer of a
+        #[doc = concat!("[`", stringify!($name), "`].")]
+        #[derive(Clone, Copy)]
+        pub struct $slices<'a> {
+            $($field: &'a [$item],)*
+        }
+
+        impl Buffers<$n> for $name {
+            type Slices<'a> = $slices<'a>;
+
+            fn lens(&self) -> [u32; $n] {
+                [$(arena_len(self.$field.len()),)*]
+            }
+
+            fn slices(&self, start: [u32; $n], end: [u32; $n]) -> $slices<'_> {
+                // Fields are initialised in the order written, one range each.
+                let mut ranges = start.into_iter().zip(end);
+                let mut next = || {
+                    let (a, b) = ranges.next().expect("one start per buffer");
+                    a as usize..b as usize
+                };
+                $slices {
+                    $($field: &self.$field[next()],)*
+                }
+            }
+
+            fn extend(&mut self, items: $slices<'_>) {
+                $(self.$field.extend_from_slice(items.$field);)*
+            }
+
+            fn append(&mut self, other: &Self) {
+                $(self.$field.extend_from_slice(&other.$field);)*
+            }
+
+            fn shrink_to_fit(&mut self) {
+                $(self.$field.shrink_to_fit();)*
+            }
+        }
+    };
+}
+
+buffers! {
+    /// The buffers of a [`Panels`].
+    PanelBuffers, PanelSlices, 5 {
+        vertices: DVec3,
+        facet_indices: u32,
+        facet_ends: u32,
+        holes: Hole,
+        labels: Label,
+    }
+}
+
+buffers! {
+    /// The buffers of a [`FlatPanels`]: points, outline indices, folds, holes, labels.
+    FlatBuffers, FlatSlices, 6 {
+        points: DVec2,
+        loop_indices: u32,
+        loop_ends: u32,
+        folds: Fold,
+        holes: FlatHole,
+        labels: FlatLabel,
+    }
+}
+
+/// What an arena keeps of one panel beside its items, and where they start in each
+/// of its `N` buffers.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct PanelHead {
-    source: Source,
-    starts: PanelStarts,
-    labels_dropped: LeftOut,
+struct Head<H, const N: usize> {
+    info: H,
+    starts: [u32; N],
 }
 
-/// The 3D panels of a job, all in one arena, as [`FlatPanels`] keeps the flat ones:
-/// one buffer per kind of item and a small head per panel. Panels are handed out as
-/// [`PanelRef`]s.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Panels {
-    heads: Vec<PanelHead>,
-    vertices: Vec<DVec3>,
-    facet_indices: Vec<u32>,
-    facet_ends: Vec<u32>,
-    holes: Vec<Hole>,
-    labels: Vec<Label>,
+/// Panels in one arena: the buffers `B` and a small head per panel, keeping what `H`
+/// holds of it beside its items and where they start in each of the `N` buffers. A
+/// big job has millions of flat panels of a dozen points each; as separate
+/// [`FlatPanel`]s they cost four allocations and a 176-byte struct apiece, more than
+/// their points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PanelArena<H, B, const N: usize> {
+    heads: Vec<Head<H, N>>,
+    buffers: B,
 }
 
-/// The panels of a [`Panels`], in order.
-pub type PanelsIter<'a> = ArenaIter<'a, Panels>;
+impl<H, B: Default, const N: usize> Default for PanelArena<H, B, N> {
+    fn default() -> Self {
+        PanelArena {
+            heads: Vec::new(),
+            buffers: B::default(),
+        }
+    }
+}
 
-/// The panels of a [`FlatPanels`], in order.
-pub type FlatPanelsIter<'a> = ArenaIter<'a, FlatPanels>;
-
-impl Panels {
+impl<H: Copy, B: Buffers<N>, const N: usize> PanelArena<H, B, N> {
     /// No panels.
     pub fn new() -> Self {
         Self::default()
-    }
-
-    /// Panels `make(0)`, …, `make(count - 1)`, made in parallel a chunk at a time and
-    /// stored in that order (so the thread count changes nothing).
-    pub fn build(count: usize, make: impl Fn(usize) -> Panel + Sync) -> Self {
-        let built: Result<Panels, std::convert::Infallible> = fill_arena(count, |i| Ok(make(i)));
-        let Ok(mut all) = built;
-        all.shrink_to_fit();
-        all
     }
 
     /// Number of panels.
@@ -72,47 +151,115 @@ impl Panels {
         self.heads.is_empty()
     }
 
+    /// Gives back spare capacity (the arena is filled once and kept).
+    pub fn shrink_to_fit(&mut self) {
+        self.heads.shrink_to_fit();
+        self.buffers.shrink_to_fit();
+    }
+
+    /// The panels in order.
+    pub fn iter(&self) -> ArenaIter<'_, Self>
+    where
+        Self: Views,
+    {
+        ArenaIter::new(self)
+    }
+
+    /// Appends a panel's head and a copy of its items.
+    ///
+    /// # Panics
+    /// When a buffer would pass 2³² items (about 100 GB of vertices alone).
+    fn push_parts(&mut self, info: H, items: B::Slices<'_>) {
+        let starts = self.buffers.lens();
+        self.buffers.extend(items);
+        self.buffers.lens();
+        self.heads.push(Head { info, starts });
+    }
+
+    /// Panel `i`'s head and items.
+    ///
+    /// # Panics
+    /// When there is no panel `i`, as indexing does.
+    fn parts(&self, i: usize) -> (H, B::Slices<'_>) {
+        let head = self.heads[i];
+        let end = self
+            .heads
+            .get(i + 1)
+            .map_or_else(|| self.buffers.lens(), |next| next.starts);
+        (head.info, self.buffers.slices(head.starts, end))
+    }
+
+    /// Appends `other`'s panels after these.
+    fn join(&mut self, other: Self) {
+        let offset = self.buffers.lens();
+        self.buffers.append(&other.buffers);
+        // Checked before the shift: no shifted start can pass the new lengths.
+        self.buffers.lens();
+        self.heads.extend(other.heads.iter().map(|head| Head {
+            starts: std::array::from_fn(|k| head.starts[k] + offset[k]),
+            ..*head
+        }));
+    }
+}
+
+/// What a [`Panels`] keeps of one panel beside its buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PanelInfo {
+    source: Source,
+    labels_dropped: LeftOut,
+}
+
+/// What a [`FlatPanels`] keeps of one panel beside its buffers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FlatInfo {
+    source: Source,
+    developability_error: f64,
+    area: f64,
+}
+
+/// The 3D panels of a job, all in one arena, as [`FlatPanels`] keeps the flat ones.
+/// Panels are handed out as [`PanelRef`]s.
+pub type Panels = PanelArena<PanelInfo, PanelBuffers, 5>;
+
+/// The flat panels of a job, all in one arena. Panels are handed out as
+/// [`FlatPanelRef`]s.
+pub type FlatPanels = PanelArena<FlatInfo, FlatBuffers, 6>;
+
+/// The panels of a [`Panels`], in order.
+pub type PanelsIter<'a> = ArenaIter<'a, Panels>;
+
+/// The panels of a [`FlatPanels`], in order.
+pub type FlatPanelsIter<'a> = ArenaIter<'a, FlatPanels>;
+
+impl Panels {
+    /// Panels `make(0)`, …, `make(count - 1)`, made in parallel a chunk at a time and
+    /// stored in that order (so the thread count changes nothing).
+    pub fn build(count: usize, make: impl Fn(usize) -> Panel + Sync) -> Self {
+        let built: Result<Panels, std::convert::Infallible> = fill_arena(count, |i| Ok(make(i)));
+        let Ok(mut all) = built;
+        all.shrink_to_fit();
+        all
+    }
+
     /// Appends a copy of a panel.
     ///
     /// # Panics
     /// When a buffer would pass 2³² items (about 100 GB of vertices alone).
     pub fn push(&mut self, panel: PanelRef<'_>) {
-        let starts = self.lens();
-        self.vertices.extend_from_slice(panel.vertices);
-        self.facet_indices.extend_from_slice(panel.facets.indices);
-        self.facet_ends.extend_from_slice(panel.facets.ends);
-        self.holes.extend_from_slice(panel.holes);
-        self.labels.extend_from_slice(panel.labels);
-        self.lens();
-        self.heads.push(PanelHead {
+        let info = PanelInfo {
             source: panel.source,
-            starts,
             labels_dropped: panel.labels_dropped,
-        });
-    }
-
-    /// The length of every buffer: where the next panel's items start.
-    ///
-    /// # Panics
-    /// When a buffer has passed 2³² items.
-    fn lens(&self) -> PanelStarts {
-        PanelStarts {
-            vertices: arena_len(self.vertices.len()),
-            facet_indices: arena_len(self.facet_indices.len()),
-            facet_ends: arena_len(self.facet_ends.len()),
-            holes: arena_len(self.holes.len()),
-            labels: arena_len(self.labels.len()),
-        }
-    }
-
-    /// Gives back spare capacity (the arena is filled once and kept).
-    pub fn shrink_to_fit(&mut self) {
-        self.heads.shrink_to_fit();
-        self.vertices.shrink_to_fit();
-        self.facet_indices.shrink_to_fit();
-        self.facet_ends.shrink_to_fit();
-        self.holes.shrink_to_fit();
-        self.labels.shrink_to_fit();
+        };
+        self.push_parts(
+            info,
+            PanelSlices {
+                vertices: panel.vertices,
+                facet_indices: panel.facets.indices,
+                facet_ends: panel.facets.ends,
+                holes: panel.holes,
+                labels: panel.labels,
+            },
+        );
     }
 
     /// Panel `i`.
@@ -120,29 +267,18 @@ impl Panels {
     /// # Panics
     /// When there is no panel `i`, as indexing does.
     pub fn get(&self, i: usize) -> PanelRef<'_> {
-        let head = &self.heads[i];
-        let start = head.starts;
-        let end = self
-            .heads
-            .get(i + 1)
-            .map_or_else(|| self.lens(), |next| next.starts);
-        let range = |a: u32, b: u32| a as usize..b as usize;
+        let (info, items) = self.parts(i);
         PanelRef {
-            source: head.source,
-            vertices: &self.vertices[range(start.vertices, end.vertices)],
+            source: info.source,
+            vertices: items.vertices,
             facets: LoopsRef {
-                indices: &self.facet_indices[range(start.facet_indices, end.facet_indices)],
-                ends: &self.facet_ends[range(start.facet_ends, end.facet_ends)],
+                indices: items.facet_indices,
+                ends: items.facet_ends,
             },
-            holes: &self.holes[range(start.holes, end.holes)],
-            labels: &self.labels[range(start.labels, end.labels)],
-            labels_dropped: head.labels_dropped,
+            holes: items.holes,
+            labels: items.labels,
+            labels_dropped: info.labels_dropped,
         }
-    }
-
-    /// The panels in order.
-    pub fn iter(&self) -> PanelsIter<'_> {
-        ArenaIter::new(self)
     }
 }
 
@@ -166,27 +302,7 @@ impl Arena for Panels {
     }
 
     fn append(&mut self, other: Panels) {
-        let offset = self.lens();
-        self.vertices.extend_from_slice(&other.vertices);
-        self.facet_indices.extend_from_slice(&other.facet_indices);
-        self.facet_ends.extend_from_slice(&other.facet_ends);
-        self.holes.extend_from_slice(&other.holes);
-        self.labels.extend_from_slice(&other.labels);
-        // Checked before the shift: no shifted start can pass the new lengths.
-        self.lens();
-        self.heads.extend(other.heads.iter().map(|head| {
-            let s = head.starts;
-            PanelHead {
-                starts: PanelStarts {
-                    vertices: s.vertices + offset.vertices,
-                    facet_indices: s.facet_indices + offset.facet_indices,
-                    facet_ends: s.facet_ends + offset.facet_ends,
-                    holes: s.holes + offset.holes,
-                    labels: s.labels + offset.labels,
-                },
-                ..*head
-            }
-        }));
+        self.join(other);
     }
 }
 
@@ -206,103 +322,28 @@ impl<'a> IntoIterator for &'a Panels {
     }
 }
 
-/// Where one panel's items start in each buffer of a [`FlatPanels`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct FlatStarts {
-    points: u32,
-    loop_indices: u32,
-    loop_ends: u32,
-    folds: u32,
-    holes: u32,
-    labels: u32,
-}
-
-/// What a [`FlatPanels`] keeps of one panel beside its buffers.
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct FlatHead {
-    source: Source,
-    starts: FlatStarts,
-    developability_error: f64,
-    area: f64,
-}
-
-/// The flat panels of a job, all in one arena: one buffer per kind of item (points,
-/// outline indices, folds, holes, labels) and a small head per panel saying where
-/// its items start. A big job has millions of flat panels of a dozen points each; as
-/// separate [`FlatPanel`]s they cost four allocations and a 176-byte struct apiece,
-/// more than their points. Panels are handed out as [`FlatPanelRef`]s.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FlatPanels {
-    heads: Vec<FlatHead>,
-    points: Vec<DVec2>,
-    loop_indices: Vec<u32>,
-    loop_ends: Vec<u32>,
-    folds: Vec<Fold>,
-    holes: Vec<FlatHole>,
-    labels: Vec<FlatLabel>,
-}
-
 impl FlatPanels {
-    /// No panels.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// Number of panels.
-    pub fn len(&self) -> usize {
-        self.heads.len()
-    }
-
-    /// No panels at all.
-    pub fn is_empty(&self) -> bool {
-        self.heads.is_empty()
-    }
-
     /// Appends a copy of a panel.
     ///
     /// # Panics
     /// When a buffer would pass 2³² items (about 70 GB of points alone).
     pub fn push(&mut self, panel: FlatPanelRef<'_>) {
-        let starts = self.lens();
-        self.points.extend_from_slice(panel.points);
-        self.loop_indices.extend_from_slice(panel.outline.indices);
-        self.loop_ends.extend_from_slice(panel.outline.ends);
-        self.folds.extend_from_slice(panel.folds);
-        self.holes.extend_from_slice(panel.holes);
-        self.labels.extend_from_slice(panel.labels);
-        self.lens();
-        self.heads.push(FlatHead {
+        let info = FlatInfo {
             source: panel.source,
-            starts,
             developability_error: panel.developability_error,
             area: panel.area,
-        });
-    }
-
-    /// The length of every buffer: where the next panel's items start.
-    ///
-    /// # Panics
-    /// When a buffer has passed 2³² items.
-    fn lens(&self) -> FlatStarts {
-        FlatStarts {
-            points: arena_len(self.points.len()),
-            loop_indices: arena_len(self.loop_indices.len()),
-            loop_ends: arena_len(self.loop_ends.len()),
-            folds: arena_len(self.folds.len()),
-            holes: arena_len(self.holes.len()),
-            labels: arena_len(self.labels.len()),
-        }
-    }
-
-    /// Gives back spare capacity (the arena is filled once and kept).
-    pub fn shrink_to_fit(&mut self) {
-        self.heads.shrink_to_fit();
-        self.points.shrink_to_fit();
-        self.loop_indices.shrink_to_fit();
-        self.loop_ends.shrink_to_fit();
-        self.folds.shrink_to_fit();
-        self.holes.shrink_to_fit();
-        self.labels.shrink_to_fit();
+        };
+        self.push_parts(
+            info,
+            FlatSlices {
+                points: panel.points,
+                loop_indices: panel.outline.indices,
+                loop_ends: panel.outline.ends,
+                folds: panel.folds,
+                holes: panel.holes,
+                labels: panel.labels,
+            },
+        );
     }
 
     /// Panel `i`.
@@ -310,31 +351,20 @@ impl FlatPanels {
     /// # Panics
     /// When there is no panel `i`, as indexing does.
     pub fn get(&self, i: usize) -> FlatPanelRef<'_> {
-        let head = &self.heads[i];
-        let start = head.starts;
-        let end = self
-            .heads
-            .get(i + 1)
-            .map_or_else(|| self.lens(), |next| next.starts);
-        let range = |a: u32, b: u32| a as usize..b as usize;
+        let (info, items) = self.parts(i);
         FlatPanelRef {
-            source: head.source,
-            points: &self.points[range(start.points, end.points)],
+            source: info.source,
+            points: items.points,
             outline: LoopsRef {
-                indices: &self.loop_indices[range(start.loop_indices, end.loop_indices)],
-                ends: &self.loop_ends[range(start.loop_ends, end.loop_ends)],
+                indices: items.loop_indices,
+                ends: items.loop_ends,
             },
-            folds: &self.folds[range(start.folds, end.folds)],
-            holes: &self.holes[range(start.holes, end.holes)],
-            labels: &self.labels[range(start.labels, end.labels)],
-            developability_error: head.developability_error,
-            area: head.area,
+            folds: items.folds,
+            holes: items.holes,
+            labels: items.labels,
+            developability_error: info.developability_error,
+            area: info.area,
         }
-    }
-
-    /// The panels in order.
-    pub fn iter(&self) -> FlatPanelsIter<'_> {
-        ArenaIter::new(self)
     }
 }
 
@@ -390,29 +420,7 @@ impl Arena for FlatPanels {
     }
 
     fn append(&mut self, other: FlatPanels) {
-        let offset = self.lens();
-        self.points.extend_from_slice(&other.points);
-        self.loop_indices.extend_from_slice(&other.loop_indices);
-        self.loop_ends.extend_from_slice(&other.loop_ends);
-        self.folds.extend_from_slice(&other.folds);
-        self.holes.extend_from_slice(&other.holes);
-        self.labels.extend_from_slice(&other.labels);
-        // Checked before the shift: no shifted start can pass the new lengths.
-        self.lens();
-        self.heads.extend(other.heads.iter().map(|head| {
-            let s = head.starts;
-            FlatHead {
-                starts: FlatStarts {
-                    points: s.points + offset.points,
-                    loop_indices: s.loop_indices + offset.loop_indices,
-                    loop_ends: s.loop_ends + offset.loop_ends,
-                    folds: s.folds + offset.folds,
-                    holes: s.holes + offset.holes,
-                    labels: s.labels + offset.labels,
-                },
-                ..*head
-            }
-        }));
+        self.join(other);
     }
 }
 
@@ -534,8 +542,8 @@ mod tests {
         assert!(Panels::new().is_empty() && FlatPanels::new().is_empty());
         // What a panel costs beside its items, against an owned panel's struct (the
         // figures in docs/DESIGN.md).
-        assert_eq!(std::mem::size_of::<PanelHead>(), 72);
-        assert_eq!(std::mem::size_of::<FlatHead>(), 64);
+        assert_eq!(std::mem::size_of::<Head<PanelInfo, 5>>(), 72);
+        assert_eq!(std::mem::size_of::<Head<FlatInfo, 6>>(), 64);
         assert_eq!(std::mem::size_of::<Panel>(), 168);
         assert_eq!(std::mem::size_of::<FlatPanel>(), 184);
     }
