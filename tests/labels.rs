@@ -219,22 +219,23 @@ fn labels_of_spot_half_edge_keep_apart_and_its_ids_are_framed() {
 }
 
 #[test]
-fn no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme() {
-    let test = "no_label_is_larger_than_its_panels_own_id_on_any_shared_model_or_scheme";
+fn no_label_is_larger_than_its_panels_own_id_on_the_first_half_of_the_shared_models() {
+    let test = "no_label_is_larger_than_its_panels_own_id_on_the_first_half_of_the_shared_models";
     if let Some(models) = common::build::half_of_the_shared_models(test, false) {
         no_label_is_larger_than_its_panels_own_id(&models);
     }
 }
 
-/// The same on the other half of the shared models.
+/// The same on the second half of the shared models.
 #[test]
-fn no_label_is_larger_than_its_panels_own_id_on_the_other_shared_models() {
-    let test = "no_label_is_larger_than_its_panels_own_id_on_the_other_shared_models";
+fn no_label_is_larger_than_its_panels_own_id_on_the_second_half_of_the_shared_models() {
+    let test = "no_label_is_larger_than_its_panels_own_id_on_the_second_half_of_the_shared_models";
     if let Some(models) = common::build::half_of_the_shared_models(test, true) {
         no_label_is_larger_than_its_panels_own_id(&models);
     }
 }
 
+/// Every scheme on `models` at 2 ft and 4 ft: no label is larger than its panel's own id.
 fn no_label_is_larger_than_its_panels_own_id(models: &[std::path::PathBuf]) {
     let tmp = TempDir::new().unwrap();
     // The README's build: 4 ft at the thesis budget of 625 edges; and 2 ft, where the

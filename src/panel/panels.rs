@@ -172,6 +172,7 @@ impl<H: Copy, B: Buffers<N>, const N: usize> PanelArena<H, B, N> {
     fn push_parts(&mut self, info: H, items: B::Slices<'_>) {
         let starts = self.buffers.lens();
         self.buffers.extend(items);
+        // Checked after the copy: no buffer may pass what a u32 start can index.
         self.buffers.lens();
         self.heads.push(Head { info, starts });
     }

@@ -517,9 +517,7 @@ mod tests {
         let options = |rotations, mirror| NestOptions {
             rotations,
             mirror,
-            effort: 1,
-            seed: 0,
-            time_limit: None,
+            ..options()
         };
         let sheet = SheetSpec {
             width: 600.0,
