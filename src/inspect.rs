@@ -122,7 +122,7 @@ pub fn inspect(
         .schemes()
         .iter()
         .map(|scheme| {
-            let convex = scheme.needs_convex_faces();
+            let convex = scheme.info().needs_convex_faces;
             let r = mesh::split::faces_to_split(&mesh, settings.planarity_tol, convex);
             Preparation {
                 scheme: scheme.name(),

@@ -32,8 +32,8 @@ use unfold::panel::{
 };
 use unfold::record::Params;
 use unfold::scheme::{
-    face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Registry, Scheme,
-    SchemeError, SchemeOutput,
+    face_band, Configured, Configuring, OptionValues, PanelDefaults, PanelOptions, Registry,
+    Scheme, SchemeError, SchemeInfo, SchemeOutput,
 };
 
 // =======================================================================================
@@ -60,13 +60,21 @@ struct ToyOptions {
     shrink: f64,
 }
 
-impl Scheme for Toy {
-    fn name(&self) -> &'static str {
-        "toy"
-    }
+const TOY_INFO: SchemeInfo = SchemeInfo {
+    name: "toy",
+    about: "one shrunk panel per face (a test of the registry)",
+    defaults: PanelDefaults {
+        face_scale: 1.0,
+        holes: 0,
+        holes_allowed: &[0],
+    },
+    needs_convex_faces: false,
+    overlap_fix: "a smaller --toy-shrink",
+};
 
-    fn about(&self) -> &'static str {
-        "one shrunk panel per face (a test of the registry)"
+impl Scheme for Toy {
+    fn info(&self) -> &SchemeInfo {
+        &TOY_INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -79,27 +87,7 @@ impl Scheme for Toy {
         )
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            face_scale: 1.0,
-            holes: 0,
-            holes_allowed: &[0],
-        }
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        false
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --toy-shrink"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         let args: ToyArgs = values.parse()?;
         let shrink = unfold::units::fraction("toy-shrink", args.toy_shrink, TOY_SHRINK)?;
         Ok(Box::new(ToyOptions { panel, shrink }))
@@ -165,40 +153,28 @@ struct PairOptions {
     panel: PanelOptions,
 }
 
-impl Scheme for Pairs {
-    fn name(&self) -> &'static str {
-        "pairs"
-    }
+const PAIRS_INFO: SchemeInfo = SchemeInfo {
+    name: "pairs",
+    about: "faces joined in pairs across an edge (a test of a new kind of panel)",
+    defaults: PanelDefaults {
+        face_scale: 1.0,
+        holes: 0,
+        holes_allowed: &[0],
+    },
+    needs_convex_faces: false,
+    overlap_fix: "a model with convex faces",
+};
 
-    fn about(&self) -> &'static str {
-        "faces joined in pairs across an edge (a test of a new kind of panel)"
+impl Scheme for Pairs {
+    fn info(&self) -> &SchemeInfo {
+        &PAIRS_INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
         Vec::new()
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            face_scale: 1.0,
-            holes: 0,
-            holes_allowed: &[0],
-        }
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        false
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a model with convex faces"
-    }
-
-    fn configure(
-        &self,
-        _values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, _values: &OptionValues, panel: PanelOptions) -> Configuring {
         Ok(Box::new(PairOptions { panel }))
     }
 }

@@ -84,7 +84,7 @@ fn per_scheme<T: PartialEq + Display>(
             values: registry
                 .schemes()
                 .iter()
-                .map(|s| (s.name(), value(&s.defaults()).to_string()))
+                .map(|s| (s.name(), value(&s.info().defaults).to_string()))
                 .collect(),
             sentence: registry.describe_defaults(value),
         },

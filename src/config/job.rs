@@ -214,7 +214,7 @@ impl BuildOptions {
 
     /// `--face-scale` and `--holes`, whose defaults and allowed values are `scheme`'s.
     fn connections(&self, scheme: &dyn Scheme) -> Result<(f64, u32)> {
-        let scheme_defaults = scheme.defaults();
+        let scheme_defaults = scheme.info().defaults;
         let face_scale = fraction("face-scale", self.face_scale, scheme_defaults.face_scale)
             .map_err(Error::Usage)?;
         let holes = self.holes.unwrap_or(scheme_defaults.holes);

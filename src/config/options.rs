@@ -195,7 +195,7 @@ impl BuildOptions {
         let schemes: Vec<clap::builder::PossibleValue> = registry
             .schemes()
             .iter()
-            .map(|s| clap::builder::PossibleValue::new(s.name()).help(s.about()))
+            .map(|s| clap::builder::PossibleValue::new(s.name()).help(s.info().about))
             .collect();
         let scheme_help = format!("Panel scheme: {}", registry.names().join(", "));
         let command = command.mut_arg("scheme", |a| {

@@ -58,7 +58,7 @@ pub fn scheme_mesh(
     let split = faces_to_split(
         &mesh,
         job.model.planarity_tol,
-        job.scheme.scheme.needs_convex_faces(),
+        job.scheme.scheme.info().needs_convex_faces,
     );
     if job.nonplanar == NonPlanar::Error && !split.non_planar.is_empty() {
         let worst = FaceId(split.non_planar[0]);
@@ -313,7 +313,7 @@ pub fn flatten(job: &Job, prepared: &Prepared, output: &SchemeOutput) -> Result<
                 "its face is far from planar (planarity error {warped:.3}): lower --planarity-tol so such faces are triangulated"
             )
         } else {
-            format!("try {}", job.scheme.scheme.overlap_fix())
+            format!("try {}", job.scheme.scheme.info().overlap_fix)
         };
         return Err(Error::Build(format!(
             "panel {} overlaps itself when unrolled; {advice}",

@@ -20,8 +20,8 @@ use super::rigid::sheet::{
     rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
 };
 use super::{
-    args_of, face_band, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme, SchemeError,
-    SchemeOutput,
+    args_of, face_band, Configured, Configuring, OptionValues, PanelOptions, Scheme, SchemeError,
+    SchemeInfo, SchemeOutput,
 };
 use crate::mesh::{EdgeId, FaceId, HalfedgeId, Mesh};
 use crate::option_default::state_defaults;
@@ -103,13 +103,18 @@ pub struct HalfEdgeOptions {
     pub rigid: RigidSheet,
 }
 
-impl Scheme for HalfEdge {
-    fn name(&self) -> &'static str {
-        "half-edge"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "half-edge",
+    about: "one panel per face, tabs on interior edges",
+    defaults: TAB_DEFAULTS,
+    // A tab lies in the neighbour face along one edge: star-shaped faces suffice.
+    needs_convex_faces: false,
+    overlap_fix: "a smaller --tab-height",
+};
 
-    fn about(&self) -> &'static str {
-        "one panel per face, tabs on interior edges"
+impl Scheme for HalfEdge {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -119,24 +124,7 @@ impl Scheme for HalfEdge {
         )
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        TAB_DEFAULTS
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // A tab lies in the neighbour face along one edge: star-shaped faces suffice.
-        false
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --tab-height"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         let args: HalfEdgeArgs = values.parse()?;
         let rigid = args.rigid.resolve(&panel)?;
         Ok(Box::new(HalfEdgeOptions {

@@ -34,30 +34,41 @@ use crate::record::{round4, Params};
 
 /// A panel scheme: what the command line, the config file and the pipeline need of it.
 pub trait Scheme: Send + Sync {
-    /// Its name for `--scheme` (kebab-case).
-    fn name(&self) -> &'static str;
-    /// One sentence for `--help`.
-    fn about(&self) -> &'static str;
+    /// Its name, help line and the facts the pipeline reads before a build.
+    fn info(&self) -> &SchemeInfo;
     /// Its own options (clap arguments with long names; the config file takes the same
     /// keys). Schemes may share an option by declaring the same argument.
     fn options(&self) -> Vec<clap::Arg> {
         Vec::new()
     }
-    /// Its defaults for the options every scheme takes.
-    fn defaults(&self) -> PanelDefaults;
-    /// True when its faces must be convex (the rest are split into triangles first).
-    fn needs_convex_faces(&self) -> bool;
-    /// What a user changes when one of its panels overlaps itself when unrolled (the
-    /// option that makes its connectors smaller, or its pieces shorter).
-    fn overlap_fix(&self) -> &'static str;
     /// Checks its own option `values` and fills in their defaults. An error is a usage
     /// message naming the option (`--bridge-scale: ...`).
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String>;
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring;
+    /// Its name for `--scheme`.
+    fn name(&self) -> &'static str {
+        self.info().name
+    }
 }
+
+/// What a scheme is: one constant per scheme, read by `--help`, the defaults table
+/// and the checks before a build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SchemeInfo {
+    /// Its name for `--scheme` (kebab-case).
+    pub name: &'static str,
+    /// One sentence for `--help`.
+    pub about: &'static str,
+    /// Its defaults for the options every scheme takes.
+    pub defaults: PanelDefaults,
+    /// True when its faces must be convex (the rest are split into triangles first).
+    pub needs_convex_faces: bool,
+    /// What a user changes when one of its panels overlaps itself when unrolled (the
+    /// option that makes its connectors smaller, or its pieces shorter).
+    pub overlap_fix: &'static str,
+}
+
+/// A scheme with its options resolved, or the usage message that refuses them.
+pub type Configuring = Result<Box<dyn Configured>, String>;
 
 /// A scheme with its options resolved, ready to build panels.
 pub trait Configured: fmt::Debug + Send + Sync {
@@ -469,7 +480,8 @@ mod tests {
                 .filter_map(|a| a.get_long().map(|l| format!("--{l}")))
                 .collect();
             let named: Vec<&str> = scheme
-                .overlap_fix()
+                .info()
+                .overlap_fix
                 .split(|c: char| c.is_whitespace() || c == '(' || c == ')' || c == ',')
                 .filter(|w| w.starts_with("--"))
                 .collect();

@@ -14,7 +14,7 @@ use super::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
 use super::rigid::sheet::{
     rigid_defaults, rigid_output, Connectors, PanelNames, RigidArgs, RigidSheet,
 };
-use super::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
+use super::{args_of, Configured, Configuring, OptionValues, PanelOptions, SchemeInfo};
 use super::{Scheme, SchemeError, SchemeOutput};
 use crate::mesh::coplanar::{flat_regions, RegionRules};
 use crate::mesh::{FaceId, Mesh};
@@ -65,13 +65,18 @@ pub struct NetOptions {
     pub rigid: RigidSheet,
 }
 
-impl Scheme for Net {
-    fn name(&self) -> &'static str {
-        "net"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "net",
+    about: "islands of many faces joined along folds, glue tabs on the cuts",
+    defaults: TAB_DEFAULTS,
+    // The overlap test separates convex polygons.
+    needs_convex_faces: true,
+    overlap_fix: "a smaller --island-spread or --max-island-faces (smaller islands)",
+};
 
-    fn about(&self) -> &'static str {
-        "islands of many faces joined along folds, glue tabs on the cuts"
+impl Scheme for Net {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -89,24 +94,7 @@ impl Scheme for Net {
         )
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        TAB_DEFAULTS
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // The overlap test separates convex polygons.
-        true
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --island-spread or --max-island-faces (smaller islands)"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         Ok(Box::new(resolve(values, panel)?))
     }
 }

@@ -89,7 +89,7 @@ impl Registry {
     ) -> String {
         let mut groups: Vec<(T, Vec<&str>)> = Vec::new();
         for scheme in &self.schemes {
-            let v = value(&scheme.defaults());
+            let v = value(&scheme.info().defaults);
             match groups.iter_mut().find(|(g, _)| *g == v) {
                 Some((_, names)) => names.push(scheme.name()),
                 None => groups.push((v, vec![scheme.name()])),

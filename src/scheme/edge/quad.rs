@@ -28,7 +28,9 @@ use crate::mesh::{FaceId, Mesh};
 use crate::option_default::state_defaults;
 use crate::plane::{clip_half_plane, contains, distance_to_border};
 use crate::record::Params;
-use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use crate::scheme::{
+    args_of, Configured, Configuring, OptionValues, PanelOptions, Scheme, SchemeInfo,
+};
 use crate::scheme::{SchemeError, SchemeOutput};
 
 pub use super::flaps::panel_id;
@@ -36,38 +38,26 @@ pub use super::flaps::panel_id;
 /// The quad-edge scheme: one panel per edge, joined at face corners.
 pub struct QuadEdge;
 
-impl Scheme for QuadEdge {
-    fn name(&self) -> &'static str {
-        "quad-edge"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "quad-edge",
+    about: "one panel per edge: Bézier edge bands with flaps, joined at face corners",
+    defaults: EDGE_DEFAULTS,
+    // The flaps follow the neighbouring band edges, which bound a flap only inside
+    // a convex face.
+    needs_convex_faces: true,
+    overlap_fix: "a smaller --flap-scale",
+};
 
-    fn about(&self) -> &'static str {
-        "one panel per edge: Bézier edge bands with flaps, joined at face corners"
+impl Scheme for QuadEdge {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
         state_defaults(args_of::<BandArgs>(), &band_defaults())
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        EDGE_DEFAULTS
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // The flaps follow the neighbouring band edges, which bound a flap only inside
-        // a convex face.
-        true
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --flap-scale"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         Ok(Box::new(values.parse::<BandArgs>()?.resolve(panel)?))
     }
 }

@@ -23,7 +23,9 @@ use super::panels::{edge_scheme, WidenFor};
 use crate::mesh::{FaceId, Mesh};
 use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::Params;
-use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions, Scheme};
+use crate::scheme::{
+    args_of, Configured, Configuring, OptionValues, PanelOptions, Scheme, SchemeInfo,
+};
 use crate::scheme::{SchemeError, SchemeOutput};
 
 /// The winged-edge scheme: quad-edge panels with wings along the neighbouring edges.
@@ -54,13 +56,18 @@ pub struct WingedEdgeOptions {
     pub shift: i32,
 }
 
-impl Scheme for WingedEdge {
-    fn name(&self) -> &'static str {
-        "winged-edge"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "winged-edge",
+    about: "quad-edge panels with wings along the neighbouring face edges",
+    defaults: EDGE_DEFAULTS,
+    // As quad-edge: flaps and wings follow the neighbouring band edges.
+    needs_convex_faces: true,
+    overlap_fix: "a smaller --flap-scale",
+};
 
-    fn about(&self) -> &'static str {
-        "quad-edge panels with wings along the neighbouring face edges"
+impl Scheme for WingedEdge {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -69,24 +76,7 @@ impl Scheme for WingedEdge {
         state_defaults(args_of::<WingedEdgeArgs>(), &defaults)
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        EDGE_DEFAULTS
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // As quad-edge: flaps and wings follow the neighbouring band edges.
-        true
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --flap-scale"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         Ok(Box::new(resolve(values, panel)?))
     }
 }

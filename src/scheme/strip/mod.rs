@@ -40,7 +40,7 @@ use crate::option_default::{state_defaults, OptionDefault};
 use crate::record::{round4, Params};
 use crate::scheme::island::{FlatFoldArgs, IslandOptions, FLAT_FOLD_DEG};
 use crate::scheme::kit::tab::{tab_defaults, TabArgs, TAB_DEFAULTS};
-use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
+use crate::scheme::{args_of, Configured, Configuring, OptionValues, PanelOptions, SchemeInfo};
 use crate::scheme::{Scheme, SchemeError, SchemeOutput};
 use cover::STAYS_OFF;
 use field::{closed_part, Closed};
@@ -143,13 +143,18 @@ struct StripOptions {
     max_deviation: Deviation,
 }
 
-impl Scheme for Strips {
-    fn name(&self) -> &'static str {
-        "strip"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "strip",
+    about: "developable strips within --max-deviation of the model, cut into pieces that fit the sheet, glue tabs between them",
+    defaults: TAB_DEFAULTS,
+    // Faces are fanned into triangles from their first corner.
+    needs_convex_faces: true,
+    overlap_fix: "a smaller --tab-height (shorter tabs)",
+};
 
-    fn about(&self) -> &'static str {
-        "developable strips within --max-deviation of the model, cut into pieces that fit the sheet, glue tabs between them"
+impl Scheme for Strips {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -163,24 +168,7 @@ impl Scheme for Strips {
         )
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        TAB_DEFAULTS
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // Faces are fanned into triangles from their first corner.
-        true
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --tab-height (shorter tabs)"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         let args: StripArgs = values.parse()?;
         if panel.face_scale != 1.0 {
             return Err(format!(

@@ -33,8 +33,9 @@ use crate::panel::{Covers, Hole, IdKind, Label, LabelKind, Loops, Name, Panel, P
 use crate::plane::{contains, counter_clockwise, distance_to_border};
 use crate::record::{round4, Params};
 use crate::scheme::kit::thickness::{thickness, thickness_default};
-use crate::scheme::{args_of, Configured, OptionValues, PanelDefaults, PanelOptions};
+use crate::scheme::{args_of, Configured, Configuring, OptionValues, PanelDefaults};
 use crate::scheme::{ConnectionName, Scheme, SchemeError, SchemeOutput};
+use crate::scheme::{PanelOptions, SchemeInfo};
 use crate::units::fraction;
 
 pub mod ergs;
@@ -49,13 +50,23 @@ use segments::{face_part, plan_segments, Limits, Unrolled};
 /// The woven scheme: plain-weaving ribbons from the extended graph rotation system.
 pub struct Woven;
 
-impl Scheme for Woven {
-    fn name(&self) -> &'static str {
-        "woven"
-    }
+const INFO: SchemeInfo = SchemeInfo {
+    name: "woven",
+    about: "plain-weaving ribbons from the extended graph rotation system",
+    defaults: PanelDefaults {
+        // Below 1: the crossings lie between the face bands.
+        face_scale: 0.8,
+        holes: 2,
+        holes_allowed: &[0, 1, 2],
+    },
+    // A strand cuts each face corner between two band sides.
+    needs_convex_faces: true,
+    overlap_fix: "a smaller --curl-limit (shorter, straighter segments)",
+};
 
-    fn about(&self) -> &'static str {
-        "plain-weaving ribbons from the extended graph rotation system"
+impl Scheme for Woven {
+    fn info(&self) -> &SchemeInfo {
+        &INFO
     }
 
     fn options(&self) -> Vec<clap::Arg> {
@@ -69,29 +80,7 @@ impl Scheme for Woven {
         )
     }
 
-    fn defaults(&self) -> PanelDefaults {
-        PanelDefaults {
-            // Below 1: the crossings lie between the face bands.
-            face_scale: 0.8,
-            holes: 2,
-            holes_allowed: &[0, 1, 2],
-        }
-    }
-
-    fn needs_convex_faces(&self) -> bool {
-        // A strand cuts each face corner between two band sides.
-        true
-    }
-
-    fn overlap_fix(&self) -> &'static str {
-        "a smaller --curl-limit (shorter, straighter segments)"
-    }
-
-    fn configure(
-        &self,
-        values: &OptionValues,
-        panel: PanelOptions,
-    ) -> Result<Box<dyn Configured>, String> {
+    fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring {
         Ok(Box::new(WovenOptions::resolve(values, panel)?))
     }
 }
