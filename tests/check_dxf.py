@@ -2,6 +2,12 @@
 """Independent checker for the R12 DXF sheets written by `unfold`.
 
 Usage: python3 tests/check_dxf.py FILE.dxf
+       python3 tests/check_dxf.py --serve
+
+With --serve it reads one path per line on stdin and answers each with one line
+of JSON on stdout: {"entities": [...]} or {"rejected": "reason"}; the tests keep
+one such process for all their reads, which spares them starting Python and
+importing ezdxf for every file.
 
 Reads FILE.dxf with ezdxf in its normal (strict, non-recover) mode, runs the
 auditor, checks the conventions of docs/LASER.md and prints the entities as
@@ -35,9 +41,12 @@ import sys
 LAYER_COLOURS = {"CUT": 1, "SCORE": 5, "SCORE-VALLEY": 3, "ENGRAVE": 7}
 
 
+class Rejected(Exception):
+    """The file breaks a rule; the message says which."""
+
+
 def fail(msg):
-    print(f"check_dxf: {msg}", file=sys.stderr)
-    sys.exit(1)
+    raise Rejected(msg)
 
 
 def raw_tags(data):
@@ -116,19 +125,12 @@ def xy(v):
     return [float(v[0]), float(v[1])]
 
 
-def main():
-    if len(sys.argv) != 2:
-        print("usage: check_dxf.py FILE.dxf", file=sys.stderr)
-        sys.exit(2)
-    path = sys.argv[1]
+def check(path, ezdxf):
+    """The entities of the DXF at `path` after every check; raises Rejected."""
     try:
-        import ezdxf
-    except ImportError:
-        print("check_dxf: the Python package ezdxf is not installed; install it with `pip install ezdxf`",
-              file=sys.stderr)
-        sys.exit(3)
-
-    check_raw(path)
+        check_raw(path)
+    except OSError as e:
+        fail(f"cannot read {path}: {e}")
 
     try:
         doc = ezdxf.readfile(path)
@@ -195,7 +197,42 @@ def main():
             fail(f"unexpected entity type {t} on layer {layer} (only POLYLINE, LINE, CIRCLE allowed)")
         out.append(item)
 
-    # One string: json.dump streams through the pure-Python encoder, dumps uses the C one.
+    return out
+
+
+def serve(ezdxf):
+    for line in sys.stdin:
+        path = line.rstrip("\n")
+        try:
+            answer = {"entities": check(path, ezdxf)}
+        except Rejected as e:
+            answer = {"rejected": str(e)}
+        except Exception as e:  # a reader failure the checks do not name
+            answer = {"rejected": f"{type(e).__name__}: {e}"}
+        # One string: json.dump streams through the pure-Python encoder, dumps uses the C one.
+        sys.stdout.write(json.dumps(answer))
+        sys.stdout.write("\n")
+        sys.stdout.flush()
+
+
+def main():
+    if len(sys.argv) != 2:
+        print("usage: check_dxf.py FILE.dxf | --serve", file=sys.stderr)
+        sys.exit(2)
+    try:
+        import ezdxf
+    except ImportError:
+        print("check_dxf: the Python package ezdxf is not installed; install it with `pip install ezdxf`",
+              file=sys.stderr)
+        sys.exit(3)
+    if sys.argv[1] == "--serve":
+        serve(ezdxf)
+        return
+    try:
+        out = check(sys.argv[1], ezdxf)
+    except Rejected as e:
+        print(f"check_dxf: {e}", file=sys.stderr)
+        sys.exit(1)
     sys.stdout.write(json.dumps(out))
     sys.stdout.write("\n")
 

@@ -8,9 +8,10 @@
 //! SVG.
 
 use std::collections::HashSet;
+use std::io::{BufRead, BufReader, Write};
 use std::path::Path;
-use std::process::Command;
-use std::sync::{Once, OnceLock};
+use std::process::{Child, ChildStdout, Command, Stdio};
+use std::sync::{Mutex, Once, OnceLock};
 
 use dxf::entities::EntityType;
 use dxf::enums::AcadVersion;
@@ -488,32 +489,71 @@ pub fn ezdxf_wanted() -> Result<bool, String> {
     Ok(false)
 }
 
-/// Runs `python3 tests/check_dxf.py DXF` (ezdxf's strict read and audit, and the R12
-/// conventions with the default layers) and returns the entities it lists.
+/// A `python3 tests/check_dxf.py --serve` process: a path in, a line of JSON out.
+struct Ezdxf {
+    child: Child,
+    answers: BufReader<ChildStdout>,
+}
+
+impl Ezdxf {
+    fn start() -> Result<Self, String> {
+        let script = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests")
+            .join("check_dxf.py");
+        // ezdxf imports numpy, whose OpenBLAS otherwise starts a spinning thread per
+        // core: a share of the suite's time for no work.
+        let mut child = Command::new("python3")
+            .arg(&script)
+            .arg("--serve")
+            .env("OPENBLAS_NUM_THREADS", "1")
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .map_err(|e| format!("cannot run python3 for tests/check_dxf.py: {e}"))?;
+        let answers = BufReader::new(child.stdout.take().expect("a piped stdout"));
+        Ok(Self { child, answers })
+    }
+
+    /// ezdxf's answer for `path`: its entities or why it rejects the file.
+    fn ask(&mut self, path: &Path) -> Result<String, String> {
+        let stdin = self.child.stdin.as_mut().expect("a piped stdin");
+        let gone = |e: std::io::Error| format!("tests/check_dxf.py --serve stopped: {e}");
+        writeln!(stdin, "{}", path.display()).map_err(gone)?;
+        stdin.flush().map_err(gone)?;
+        let mut line = String::new();
+        match self.answers.read_line(&mut line) {
+            Ok(0) => Err("tests/check_dxf.py --serve stopped without an answer".into()),
+            Ok(_) => Ok(line),
+            Err(e) => Err(gone(e)),
+        }
+    }
+}
+
+/// Reads `path` with ezdxf (`tests/check_dxf.py`: its strict read and audit, and the
+/// R12 conventions with the default layers) and returns the entities it lists. The
+/// test process keeps its ezdxf processes for later reads: starting Python and
+/// importing ezdxf takes longer than reading most sheets.
 pub fn read_dxf_with_ezdxf(path: &Path) -> Result<Vec<DxfEntity>, String> {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests")
-        .join("check_dxf.py");
-    // ezdxf imports numpy, whose OpenBLAS otherwise starts a spinning thread per core
-    // in every check: a share of the suite's time for no work.
-    let out = Command::new("python3")
-        .arg(&script)
-        .arg(path)
-        .env("OPENBLAS_NUM_THREADS", "1")
-        .output()
-        .map_err(|e| format!("cannot run python3 for tests/check_dxf.py: {e}"))?;
-    let stderr = String::from_utf8_lossy(&out.stderr).trim().to_string();
-    if !out.status.success() {
+    static IDLE: Mutex<Vec<Ezdxf>> = Mutex::new(Vec::new());
+    let idle = IDLE.lock().unwrap_or_else(|e| e.into_inner()).pop();
+    let mut ezdxf = match idle {
+        Some(ezdxf) => ezdxf,
+        None => Ezdxf::start()?,
+    };
+    let answer = ezdxf.ask(path)?;
+    IDLE.lock().unwrap_or_else(|e| e.into_inner()).push(ezdxf);
+    let json: serde_json::Value = serde_json::from_str(&answer)
+        .map_err(|e| format!("check_dxf.py printed invalid JSON: {e}"))?;
+    if let Some(why) = json.get("rejected") {
         return Err(format!(
-            "DXF {} rejected by tests/check_dxf.py (ezdxf, {}): {stderr}",
+            "DXF {} rejected by tests/check_dxf.py (ezdxf): {}",
             path.display(),
-            out.status
+            why.as_str().unwrap_or_default()
         ));
     }
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout)
-        .map_err(|e| format!("check_dxf.py printed invalid JSON: {e}"))?;
     let list = json
-        .as_array()
+        .get("entities")
+        .and_then(|l| l.as_array())
         .ok_or("check_dxf.py output is not a JSON list")?;
     let pt = |v: &serde_json::Value| -> Option<Pt> {
         let a = v.as_array()?;
