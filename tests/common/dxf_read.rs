@@ -508,6 +508,9 @@ impl Ezdxf {
             .env("OPENBLAS_NUM_THREADS", "1")
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
+            // Rejections come back as answers; an inherited stderr would keep the
+            // test's output open after the test, until the process ends.
+            .stderr(Stdio::null())
             .spawn()
             .map_err(|e| format!("cannot run python3 for tests/check_dxf.py: {e}"))?;
         let answers = BufReader::new(child.stdout.take().expect("a piped stdout"));
