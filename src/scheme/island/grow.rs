@@ -492,3 +492,96 @@ pub(in crate::scheme) fn grow_islands(
     }
     (islands, order.into_iter().map(|(_, e)| e).collect())
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::FRAC_PI_2;
+
+    use glam::DVec3;
+
+    use super::*;
+    use crate::mesh::build::{cube, two_triangles};
+    use crate::scheme::PanelOptions;
+
+    /// Whole faces, no holes, 5 mm tabs, no sheet, islands of at most `max_faces`.
+    fn options(max_faces: Option<usize>) -> IslandOptions {
+        IslandOptions {
+            panel: PanelOptions {
+                face_scale: 1.0,
+                holes: 0,
+                hole_diameter: 1.0,
+                hole_margin: 0.5,
+                label_height: 2.0,
+                panel_limit: None,
+                scale: 1.0,
+            },
+            tab_height: 5.0,
+            max_island_faces: max_faces,
+            flat_fold: 1f64.to_radians(),
+            island_spread: 3.0,
+        }
+    }
+
+    #[test]
+    fn fold_angles_are_flat_square_or_none_on_the_rim() {
+        let flat = two_triangles(DVec3::new(30.0, 30.0, 0.0));
+        let upright = two_triangles(DVec3::new(30.0, 0.0, 30.0));
+        assert!(fold_angle(&flat, EdgeId(2)).unwrap().abs() < 1e-12);
+        assert!((fold_angle(&upright, EdgeId(2)).unwrap() - FRAC_PI_2).abs() < 1e-12);
+        for rim in [0, 1, 3, 4] {
+            assert_eq!(fold_angle(&flat, EdgeId(rim)), None, "edge {rim}");
+        }
+    }
+
+    #[test]
+    fn the_grid_names_what_lies_near_each_once_in_order() {
+        let mut grid = Grid::new(10.0);
+        let square = |x: f64| -> Vec<DVec2> {
+            [(0.0, 0.0), (25.0, 0.0), (25.0, 25.0), (0.0, 25.0)]
+                .map(|(u, v)| DVec2::new(x + u, v))
+                .to_vec()
+        };
+        grid.insert(7, &square(0.0));
+        grid.insert(3, &square(100.0));
+        grid.insert(5, &square(20.0));
+        assert_eq!(grid.near(&square(10.0)), [5, 7]);
+        assert_eq!(grid.near(&square(60.0)), Vec::<u32>::new());
+        assert_eq!(grid.near(&square(85.0)), [3]);
+    }
+
+    /// A cube unfolds into one island of its six faces: each laid flat with its own
+    /// area, none over another, every corner of a face joined to its neighbours'.
+    #[test]
+    fn a_cube_grows_into_one_island_of_six_faces_none_over_another() {
+        let mesh = cube(40.0);
+        let (islands, order) = grow_islands(&mesh, &options(None));
+        assert_eq!(order.len(), 12, "every interior edge, in fold order");
+        let live: Vec<&Vec<u32>> = islands.faces.iter().filter(|f| !f.is_empty()).collect();
+        assert_eq!(live.len(), 1);
+        assert_eq!(live[0].len(), 6);
+        let folds = islands.fold.iter().filter(|&&f| f).count();
+        assert_eq!(folds, 5, "a tree over six faces has five folds");
+        let polygons: Vec<Vec<DVec2>> = mesh.faces().map(|f| islands.polygon(&mesh, f)).collect();
+        for (f, poly) in polygons.iter().enumerate() {
+            assert!(
+                (crate::plane::area(poly).abs() - 1600.0).abs() < 1e-9,
+                "face {f}"
+            );
+            for (g, other) in polygons.iter().enumerate().skip(f + 1) {
+                assert!(
+                    separation(poly, other) >= -TOUCH,
+                    "faces {f} and {g} overlap"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn an_island_cap_of_one_face_leaves_every_face_alone() {
+        let mesh = cube(40.0);
+        let (islands, _) = grow_islands(&mesh, &options(Some(1)));
+        let live = islands.faces.iter().filter(|f| !f.is_empty()).count();
+        assert_eq!(live, 6);
+        assert!(islands.fold.iter().all(|&f| !f));
+    }
+}

@@ -227,3 +227,107 @@ pub(in crate::scheme) fn fits_sheet(hull: &[DVec2], options: &IslandOptions, roo
         .panel_limit
         .is_none_or(|limit| limit.fits(hull, room))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The axis-aligned square `[x, x + 1] × [0, 1]`, counter-clockwise.
+    fn unit_square(x: f64) -> Vec<DVec2> {
+        [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+            .map(|(u, v)| DVec2::new(x + u, v))
+            .to_vec()
+    }
+
+    #[test]
+    fn separation_is_the_gap_between_apart_squares_and_negative_when_they_overlap() {
+        let p = unit_square(0.0);
+        assert!((separation(&p, &unit_square(3.0)) - 2.0).abs() < 1e-12);
+        assert!((separation(&unit_square(3.0), &p) - 2.0).abs() < 1e-12);
+        assert!(separation(&p, &unit_square(1.0)).abs() < 1e-12, "touching");
+        assert!((separation(&p, &unit_square(0.5)) + 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn stepped_drops_points_within_a_micron_of_their_neighbour_or_the_end() {
+        let (from, to) = (DVec2::ZERO, DVec2::new(10.0, 0.0));
+        let top = [
+            DVec2::new(0.0, 0.5 * TAB_STEP),
+            DVec2::new(5.0, 5.0),
+            DVec2::new(5.0, 5.0 + 0.5 * TAB_STEP),
+            DVec2::new(9.0, 5.0),
+            DVec2::new(10.0, 0.5 * TAB_STEP),
+        ];
+        assert_eq!(
+            stepped(top.into_iter(), from, to),
+            [DVec2::new(5.0, 5.0), DVec2::new(9.0, 5.0)]
+        );
+    }
+
+    /// Every half-edge of a cube, its edge laid flat anywhere: the partner face lies
+    /// on the tab's side of the edge, and its corners come back to 3D unchanged.
+    #[test]
+    fn a_tab_frame_lays_the_partner_face_beside_the_edge_and_back() {
+        let mesh = crate::mesh::build::cube(40.0);
+        let (pa, pb) = (DVec2::new(7.0, -3.0), DVec2::new(7.0, 37.0));
+        for h in mesh.half_edges() {
+            let frame = TabFrame::on(&mesh, h, (pa, pb));
+            assert!(frame.flat(mesh.position(mesh.origin(h))).distance(pa) < 1e-9);
+            assert!(frame.flat(mesh.position(mesh.dest(h))).distance(pb) < 1e-9);
+            let partner = mesh.face(h.twin()).expect("a closed cube");
+            for v in mesh.face_vertices(partner) {
+                let p = mesh.position(v);
+                let q = frame.flat(p);
+                assert!(
+                    frame.depth(q) >= -1e-9,
+                    "{h:?}: {p} lies on the face's side"
+                );
+                assert!(frame.back(q).distance(p) < 1e-9, "{h:?}: {p} comes back");
+            }
+        }
+    }
+
+    #[test]
+    fn without_a_sheet_every_island_fits() {
+        let options = IslandOptions {
+            panel: crate::scheme::PanelOptions {
+                face_scale: 1.0,
+                holes: 0,
+                hole_diameter: 1.0,
+                hole_margin: 0.5,
+                label_height: 2.0,
+                panel_limit: None,
+                scale: 1.0,
+            },
+            tab_height: 5.0,
+            max_island_faces: None,
+            flat_fold: 0.0,
+            island_spread: 1.0,
+        };
+        let huge = unit_square(0.0)
+            .iter()
+            .map(|&p| 1e6 * p)
+            .collect::<Vec<_>>();
+        assert!(fits_sheet(&huge, &options, 0.0));
+        let limited = IslandOptions {
+            panel: crate::scheme::PanelOptions {
+                panel_limit: Some(crate::scheme::PanelLimit {
+                    width: 100.0,
+                    height: 50.0,
+                    rotations: 4,
+                }),
+                ..options.panel.clone()
+            },
+            ..options
+        };
+        let tall = unit_square(0.0)
+            .iter()
+            .map(|&p| DVec2::new(40.0 * p.x, 90.0 * p.y))
+            .collect::<Vec<_>>();
+        assert!(
+            fits_sheet(&tall, &limited, 0.0),
+            "turned a quarter, 90 × 40"
+        );
+        assert!(!fits_sheet(&tall, &limited, 10.0), "less 10 mm of room");
+    }
+}
