@@ -299,21 +299,7 @@ mod tests {
     /// an island, folds under 1° unscored, the default spread, no sheet limit.
     fn options(max_island_faces: Option<usize>) -> NetOptions {
         NetOptions {
-            islands: IslandOptions {
-                panel: PanelOptions {
-                    face_scale: 1.0,
-                    holes: 0,
-                    hole_diameter: 1.0,
-                    hole_margin: 0.5,
-                    label_height: 2.0,
-                    panel_limit: None,
-                    scale: 1.0,
-                },
-                tab_height: 5.0,
-                max_island_faces,
-                flat_fold: 1f64.to_radians(),
-                island_spread: ISLAND_SPREAD,
-            },
+            islands: crate::scheme::island::test_options(max_island_faces, ISLAND_SPREAD),
             rigid: crate::scheme::rigid::sheet::RigidSheet::CARD,
         }
     }

@@ -501,25 +501,10 @@ mod tests {
 
     use super::*;
     use crate::mesh::build::{cube, two_triangles};
-    use crate::scheme::PanelOptions;
 
-    /// Whole faces, no holes, 5 mm tabs, no sheet, islands of at most `max_faces`.
+    /// The test options with islands of at most `max_faces` and a spread of 3.
     fn options(max_faces: Option<usize>) -> IslandOptions {
-        IslandOptions {
-            panel: PanelOptions {
-                face_scale: 1.0,
-                holes: 0,
-                hole_diameter: 1.0,
-                hole_margin: 0.5,
-                label_height: 2.0,
-                panel_limit: None,
-                scale: 1.0,
-            },
-            tab_height: 5.0,
-            max_island_faces: max_faces,
-            flat_fold: 1f64.to_radians(),
-            island_spread: 3.0,
-        }
+        crate::scheme::island::test_options(max_faces, 3.0)
     }
 
     #[test]

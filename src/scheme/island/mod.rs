@@ -33,6 +33,8 @@ mod tabs;
 pub(in crate::scheme) use build::island_net;
 pub use build::{islands_along, IslandNames, IslandNet, OwnNet};
 pub(in crate::scheme) use grow::grow_islands;
+#[cfg(test)]
+pub(in crate::scheme) use options::test_options;
 pub(in crate::scheme) use options::{FlatFoldArgs, FLAT_FOLD_DEG};
 pub use options::{IslandOptions, ISLAND, MATCH};
 pub use summary::Summary;

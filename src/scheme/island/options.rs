@@ -60,3 +60,28 @@ pub struct IslandOptions {
     /// Largest ratio of an island's convex hull to its area.
     pub island_spread: f64,
 }
+
+/// Options for unit tests of the engine and the schemes on it: whole faces, no holes,
+/// 5 mm tabs, at most `max_island_faces` faces an island, folds under 1° unscored, hulls
+/// up to `island_spread` times an island's area, no sheet.
+#[cfg(test)]
+pub(in crate::scheme) fn test_options(
+    max_island_faces: Option<usize>,
+    island_spread: f64,
+) -> IslandOptions {
+    IslandOptions {
+        panel: PanelOptions {
+            face_scale: 1.0,
+            holes: 0,
+            hole_diameter: 1.0,
+            hole_margin: 0.5,
+            label_height: 2.0,
+            panel_limit: None,
+            scale: 1.0,
+        },
+        tab_height: 5.0,
+        max_island_faces,
+        flat_fold: 1f64.to_radians(),
+        island_spread,
+    }
+}

@@ -289,21 +289,7 @@ mod tests {
 
     #[test]
     fn without_a_sheet_every_island_fits() {
-        let options = IslandOptions {
-            panel: crate::scheme::PanelOptions {
-                face_scale: 1.0,
-                holes: 0,
-                hole_diameter: 1.0,
-                hole_margin: 0.5,
-                label_height: 2.0,
-                panel_limit: None,
-                scale: 1.0,
-            },
-            tab_height: 5.0,
-            max_island_faces: None,
-            flat_fold: 0.0,
-            island_spread: 1.0,
-        };
+        let options = crate::scheme::island::test_options(None, 1.0);
         let huge = unit_square(0.0)
             .iter()
             .map(|&p| 1e6 * p)
