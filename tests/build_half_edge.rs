@@ -111,8 +111,8 @@ fn every_sheet_passes_the_independent_check() {
     }
 }
 
-/// The same on the big shared models (a separate test so that it runs beside the
-/// project models). Laid out by the shelf nester: this checks the panels and the
+/// The same on fertility (a test of its own so that it runs beside the project
+/// models). Laid out by the shelf nester: this checks the panels and the
 /// sheets, not how tightly they are packed (`tests/nesting.rs` and the bench check the
 /// true-shape layout of such models), and it keeps the suite quick.
 #[test]
@@ -130,6 +130,7 @@ fn every_sheet_of_spot_passes_the_independent_check() {
     );
 }
 
+/// [`check_build`] on the shared model `name` at 4 ft on the shelf nester.
 fn check_shared_build(test: &str, name: &str) {
     if let Some(shared) = shared_models(test) {
         check_build(

@@ -1224,8 +1224,8 @@ fn open_meshes_give_boundary_edges_a_single_flap() {
 /// bends planar with rulings parallel to the edge (their quads are planar only within
 /// --planarity-tol, so the flap checks and the isometry are left to the planar models),
 /// holes of the connections that have them identical in 3D and, unrolled, within 1e-6
-/// of the size (flaps lie exactly in their face's plane). Prints sheets, lower bound and utilization (holes do not change the
-/// layout).
+/// of the size (flaps lie exactly in their face's plane). Prints sheets, lower bound
+/// and utilization (holes do not change the layout).
 #[test]
 fn fertility_has_a_panel_per_edge_and_paired_holes() {
     shared_model_has_a_panel_per_edge_and_paired_holes(
@@ -1247,51 +1247,49 @@ fn shared_model_has_a_panel_per_edge_and_paired_holes(test: &str, name: &str) {
     let Some(shared) = shared_models(test) else {
         return;
     };
-    {
-        let path = shared.join(format!("{name}.obj"));
-        let what = format!("{name} at 4ft");
-        let what = what.as_str();
-        let (m, report, p, job) = check_model(
-            &path,
-            "4ft",
-            // Shelf layout: the panels and sheets are checked, not how tight they
-            // are (that is the nesting tests' and the bench's job).
-            &["--hole-diameter", "1mm", "--nester", "shelf"],
-            DxfCheck::FirstAndLast,
-            false,
-        );
-        assert_eq!(count(&m, "input.boundary_loops"), 0, "{what}: closed");
-        check_bends(&p, &job, what, 1219.2, false);
-        let facts = check_holes(&p, &job, what, 1219.2, 1e-6, false);
-        assert!(
-            facts.with_holes > 0,
-            "{what}: no connection has room for a 1 mm hole"
-        );
-        assert_eq!(
-            count(&m, "counts.holes"),
-            facts.holes,
-            "{what}: counts.holes"
-        );
-        match fewer_holes_note(&report, 2) {
-            Some(note) => assert_eq!(
-                note,
-                (facts.fewer, p.output.connections, facts.none),
-                "{what}: {report}"
-            ),
-            None => assert_eq!(facts.fewer, 0, "{what}: {report}"),
-        }
-        eprintln!(
-            "{what}: {} of {} connections have holes ({} holes); partner holes at most {:.1e} mm apart",
-            facts.with_holes, p.output.connections, facts.holes, facts.worst_apart
-        );
-        eprintln!(
+    let path = shared.join(format!("{name}.obj"));
+    let what = format!("{name} at 4ft");
+    let what = what.as_str();
+    let (m, report, p, job) = check_model(
+        &path,
+        "4ft",
+        // Shelf layout: the panels and sheets are checked, not how tight they
+        // are (that is the nesting tests' and the bench's job).
+        &["--hole-diameter", "1mm", "--nester", "shelf"],
+        DxfCheck::FirstAndLast,
+        false,
+    );
+    assert_eq!(count(&m, "input.boundary_loops"), 0, "{what}: closed");
+    check_bends(&p, &job, what, 1219.2, false);
+    let facts = check_holes(&p, &job, what, 1219.2, 1e-6, false);
+    assert!(
+        facts.with_holes > 0,
+        "{what}: no connection has room for a 1 mm hole"
+    );
+    assert_eq!(
+        count(&m, "counts.holes"),
+        facts.holes,
+        "{what}: counts.holes"
+    );
+    match fewer_holes_note(&report, 2) {
+        Some(note) => assert_eq!(
+            note,
+            (facts.fewer, p.output.connections, facts.none),
+            "{what}: {report}"
+        ),
+        None => assert_eq!(facts.fewer, 0, "{what}: {report}"),
+    }
+    eprintln!(
+        "{what}: {} of {} connections have holes ({} holes); partner holes at most {:.1e} mm apart",
+        facts.with_holes, p.output.connections, facts.holes, facts.worst_apart
+    );
+    eprintln!(
             "{name}, quad-edge, 4 ft on 18x24in: {} panels, {} sheets, area lower bound {}, utilization {:.1}%",
             count(&m, "counts.panels"),
             count(&m, "counts.sheets"),
             count(&m, "counts.sheets_lower_bound"),
             100.0 * num(&m, "utilization")
         );
-    }
 }
 
 // =======================================================================================

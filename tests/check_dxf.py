@@ -6,7 +6,7 @@ Usage: python3 tests/check_dxf.py FILE.dxf
 
 With --serve it reads one path per line on stdin and answers each with one line
 of JSON on stdout: {"entities": [...]} or {"rejected": "reason"}; the tests keep
-one such process for all their reads, which spares them starting Python and
+such processes for all their reads, which spares them starting Python and
 importing ezdxf for every file.
 
 Reads FILE.dxf with ezdxf in its normal (strict, non-recover) mode, runs the

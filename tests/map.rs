@@ -176,8 +176,8 @@ fn the_map_of_the_thesis_bunny_names_its_edges_where_they_are_seen() {
     );
 }
 
-/// The first half of the shared models at a thesis-like budget, edge and face panels: the overview
-/// names most panels and the close-ups the rest (the cube's faces are larger than any
+/// The first half of the shared models at a thesis-like budget, edge and face panels:
+/// the overview names most panels and the close-ups the rest (the cube's faces are larger than any
 /// listed sheet at 4 ft, so it goes on a 1.5 m sheet).
 #[test]
 fn every_panel_of_the_first_half_of_the_shared_models_is_on_the_map() {
@@ -196,6 +196,8 @@ fn every_panel_of_the_second_half_of_the_shared_models_is_on_the_map() {
     }
 }
 
+/// Each of `models` in quad-edge and half-edge at 4 ft and 1,000 edges: every panel on
+/// the map.
 fn every_panel_is_on_the_map(models: &[std::path::PathBuf]) {
     assert!(models.len() >= 4, "{models:?}");
     for model in models {

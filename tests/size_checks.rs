@@ -273,12 +273,8 @@ fn too_detailed_for_its_size_gets_a_budget_that_builds(test: &str, scheme: &str)
         "{scheme} auto: {}",
         run.stderr
     );
-    assert!(
-            run.stderr
-                .contains(&format!("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to {budget} edges")),
-            "{scheme} auto: {}",
-            run.stderr
-        );
+    let said = format!("--target-edges auto: the model is too detailed for its size as it is, so it was simplified to {budget} edges");
+    assert!(run.stderr.contains(&said), "{scheme} auto: {}", run.stderr);
     let manifest = read_manifest(&out);
     assert_eq!(count(&manifest, "counts.panel_ids_left_out"), 0);
 

@@ -525,7 +525,13 @@ impl Ezdxf {
         stdin.flush().map_err(gone)?;
         let mut line = String::new();
         match self.answers.read_line(&mut line) {
-            Ok(0) => Err("tests/check_dxf.py --serve stopped without an answer".into()),
+            // Its stderr is closed, so its exit status is what is left to name.
+            Ok(0) => Err(format!(
+                "tests/check_dxf.py --serve stopped without an answer ({})",
+                self.child
+                    .wait()
+                    .map_or_else(|e| e.to_string(), |status| status.to_string())
+            )),
             Ok(_) => Ok(line),
             Err(e) => Err(gone(e)),
         }
@@ -557,7 +563,7 @@ pub fn read_dxf_with_ezdxf(path: &Path) -> Result<Vec<DxfEntity>, String> {
     let list = json
         .get("entities")
         .and_then(|l| l.as_array())
-        .ok_or("check_dxf.py output is not a JSON list")?;
+        .ok_or("check_dxf.py answered without an entities list")?;
     let pt = |v: &serde_json::Value| -> Option<Pt> {
         let a = v.as_array()?;
         Some((a.first()?.as_f64()?, a.get(1)?.as_f64()?))
