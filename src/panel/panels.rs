@@ -118,7 +118,7 @@ struct Head<H, const N: usize> {
 /// Panels in one arena: the buffers `B` and a small head per panel, keeping what `H`
 /// holds of it beside its items and where they start in each of the `N` buffers. A
 /// big job has millions of flat panels of a dozen points each; as separate
-/// [`FlatPanel`]s they cost four allocations and a 176-byte struct apiece, more than
+/// [`FlatPanel`]s they cost four allocations and a 184-byte struct apiece, more than
 /// their points.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PanelArena<H, B, const N: usize> {

@@ -1,9 +1,10 @@
 //! Panel schemes: each takes a read-only mesh (in millimetres) and its options and
 //! returns 3D panels with provenance. A scheme knows nothing of sheets or files.
 //!
-//! A scheme is one file here or in its family's folder (`edge/`, `woven/`): a type
-//! implementing [`Scheme`] (its name, help, its own command-line and config options
-//! with their defaults and checks, whether it needs convex faces) and the
+//! A scheme is one file here or in its family's folder (`edge/`, `woven/`): a
+//! [`SchemeInfo`] (its name, help, defaults, whether it needs convex faces, the fix
+//! for a panel that overlaps itself), a type implementing [`Scheme`] (that info, its
+//! own command-line and config options with their defaults and checks) and the
 //! [`Configured`] value it resolves to (the build, and what it adds to the manifest
 //! and the report). [`SCHEMES`] lists them; everything above this module reaches the
 //! schemes only through a [`Registry`]. What several schemes share is in `kit/` or in
@@ -44,8 +45,11 @@ pub trait Scheme: Send + Sync {
     /// Checks its own option `values` and fills in their defaults. An error is a usage
     /// message naming the option (`--bridge-scale: ...`).
     fn configure(&self, values: &OptionValues, panel: PanelOptions) -> Configuring;
-    /// Its name for `--scheme`.
-    fn name(&self) -> &'static str {
+}
+
+impl dyn Scheme + '_ {
+    /// Its name for `--scheme`, as its [`SchemeInfo`] states it.
+    pub fn name(&self) -> &'static str {
         self.info().name
     }
 }

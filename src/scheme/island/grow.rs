@@ -534,8 +534,8 @@ mod tests {
         assert_eq!(grid.near(&square(85.0)), [3]);
     }
 
-    /// A cube unfolds into one island of its six faces: each laid flat with its own
-    /// area, none over another, every corner of a face joined to its neighbours'.
+    /// A cube unfolds into one island of its six faces: five folds, each face laid flat
+    /// with its own area, none over another.
     #[test]
     fn a_cube_grows_into_one_island_of_six_faces_none_over_another() {
         let mesh = cube(40.0);

@@ -288,7 +288,7 @@ mod tests {
     }
 
     #[test]
-    fn without_a_sheet_every_island_fits() {
+    fn an_island_fits_without_a_sheet_and_on_one_with_its_room_left() {
         let options = crate::scheme::island::test_options(None, 1.0);
         let huge = unit_square(0.0)
             .iter()

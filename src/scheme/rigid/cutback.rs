@@ -104,7 +104,7 @@ pub fn rigid_panels(
     thickness: f64,
 ) -> Result<RigidPanels, RigidError> {
     let insets = edge_insets(mesh, thickness);
-    let frames: Vec<PlaneFrame> = mesh.faces().map(|f| face_frame(mesh, f)).collect();
+    let frames: Vec<PlaneFrame> = mesh.faces().map(|f| first_side_frame(mesh, f)).collect();
     let mut outlines = Vec::with_capacity(mesh.face_count());
     for f in mesh.faces() {
         let outline = inset_outline(mesh, f, &frames[f.0 as usize], &insets)
@@ -190,7 +190,7 @@ fn edge_insets(mesh: &Mesh, thickness: f64) -> Vec<f64> {
 }
 
 /// A face's plane with axes, x along its first side.
-fn face_frame(mesh: &Mesh, f: FaceId) -> PlaneFrame {
+fn first_side_frame(mesh: &Mesh, f: FaceId) -> PlaneFrame {
     let normal = mesh.face_normal(f);
     let h = mesh.face_half_edge(f);
     let side = mesh.position(mesh.dest(h)) - mesh.position(mesh.origin(h));
