@@ -1284,12 +1284,12 @@ fn shared_model_has_a_panel_per_edge_and_paired_holes(test: &str, name: &str) {
         facts.with_holes, p.output.connections, facts.holes, facts.worst_apart
     );
     eprintln!(
-            "{name}, quad-edge, 4 ft on 18x24in: {} panels, {} sheets, area lower bound {}, utilization {:.1}%",
-            count(&m, "counts.panels"),
-            count(&m, "counts.sheets"),
-            count(&m, "counts.sheets_lower_bound"),
-            100.0 * num(&m, "utilization")
-        );
+        "{name}, quad-edge, 4 ft on 18x24in: {} panels, {} sheets, area lower bound {}, utilization {:.1}%",
+        count(&m, "counts.panels"),
+        count(&m, "counts.sheets"),
+        count(&m, "counts.sheets_lower_bound"),
+        100.0 * num(&m, "utilization")
+    );
 }
 
 // =======================================================================================
