@@ -165,8 +165,7 @@ fn one_way(from: &[[DVec3; 3]], to: &[[DVec3; 3]], spacing: f64, reach: f64) -> 
 /// strip without an interior vertex, the strips' surface within `bound` of the model
 /// both ways, closed where the model is closed, each strip's pieces a run of it; the
 /// flat pieces keep their edge lengths. Returns (strips, pieces).
-fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, usize) {
-    let p = pipeline(job);
+fn check_strips(what: &str, p: &Pipeline, bound: f64) -> (usize, usize) {
     let surface = p.output.surface.as_ref().expect("the strips' surface");
     let size = {
         let (lo, hi) = surface
@@ -229,7 +228,7 @@ fn check_strips(what: &str, job: &unfold::config::Job, bound: f64) -> (usize, us
             "{what}: S{strip} is not one run of faces"
         );
     }
-    check_seam_numbers(what, &p, surface);
+    check_seam_numbers(what, p, surface);
     // Welded along shared curves: closed where the model is.
     assert_eq!(
         surface.boundary_loops().is_empty(),
@@ -420,13 +419,40 @@ fn strip_build_with(
     m
 }
 
+/// The build of [`strip_build_with`] (its options, the default holes) made once
+/// through the library: the sheets checked as there, and the pipeline for the strip
+/// facts with the manifest.
+fn strip_built_once(
+    model: &Path,
+    size: &str,
+    deviation: &str,
+    out: &Path,
+    shelf: bool,
+) -> (Pipeline, Value) {
+    let mut o = options("strip", size, 0, out);
+    o.holes = None;
+    o.scheme_values.set("max-deviation", deviation);
+    o.format = Some("svg,dxf".to_string());
+    if shelf {
+        o.nester = Some(unfold::nest::NesterName::Shelf);
+    } else {
+        o.effort = Some(1);
+    }
+    let (p, m) = built_once(&resolve(o, model));
+    let name = model.file_stem().unwrap().to_string_lossy().into_owned();
+    check_output(model, out, &m, &name, DxfCheck::FirstAndLast, |e| {
+        e["id"].as_str().unwrap().to_string()
+    });
+    (p, m)
+}
+
 #[test]
 fn an_open_cylinder_is_one_strip_in_one_piece() {
     let tmp = TempDir::new().unwrap();
     let profile: Vec<(f64, f64)> = (0..=4).map(|k| (50.0, 25.0 * k as f64)).collect();
     let model = revolved(tmp.path(), "cylinder", &profile, 32);
     let job = strip_job(&model, "100mm", "0.5mm", &tmp.path().join("job"));
-    assert_eq!(check_strips("cylinder", &job, 0.5), (1, 1));
+    assert_eq!(check_strips("cylinder", &pipeline(&job), 0.5), (1, 1));
     let m = strip_build(&model, "100mm", "0.5mm", &tmp.path().join("out"));
     assert_eq!(count(&m, "strip.strips"), 1);
     assert_eq!(count(&m, "strip.pieces"), 1);
@@ -458,8 +484,9 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
         ("torus", torus(tmp.path(), 32, 16, 80.0, 30.0), "1%"),
     ];
     for (name, model, deviation) in &models {
-        let job = strip_job(model, "200mm", deviation, &tmp.path().join("job"));
-        let model_triangles = triangles(&pipeline(&job).mesh);
+        let out = tmp.path().join(name);
+        let (p, m) = strip_built_once(model, "200mm", deviation, &out, false);
+        let model_triangles = triangles(&p.mesh);
         let (lo, hi) = model_triangles
             .iter()
             .flatten()
@@ -467,7 +494,7 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
                 (lo.min(q), hi.max(q))
             });
         let bound = 0.01 * (hi - lo).length();
-        let (strips, pieces) = check_strips(name, &job, bound);
+        let (strips, pieces) = check_strips(name, &p, bound);
         // An open cone unrolls whole, rim to rim; a sphere or a torus takes several.
         let least = if *name == "cone" { 1 } else { 2 };
         assert!(
@@ -477,8 +504,6 @@ fn cones_spheres_and_tori_are_strips_within_the_bound() {
         if *name == "cone" {
             assert_eq!(strips, 1, "an open cone is one strip");
         }
-        let out = tmp.path().join(name);
-        let m = strip_build(model, "200mm", deviation, &out);
         assert_eq!(count(&m, "strip.strips"), strips, "{name}");
         assert!(num(&m, "strip.measured_deviation") <= bound, "{name}");
         // The assembled model is the strips' surface, without tabs: triangles only,
@@ -565,14 +590,12 @@ fn the_bunny_is_strips_within_the_bound() {
     };
     let tmp = TempDir::new().unwrap();
     let bunny = simplified_obj(&shared.join("stanford-bunny.obj"), 1500, true, tmp.path());
-    let job = strip_job(&bunny, "2ft", "1%", &tmp.path().join("job"));
-    let p = pipeline(&job);
+    let (p, _) = strip_built_once(&bunny, "2ft", "1%", &tmp.path().join("out"), false);
     let pts = p.mesh.positions();
     let (lo, hi) = pts.iter().fold((DVec3::MAX, DVec3::MIN), |(lo, hi), &q| {
         (lo.min(q), hi.max(q))
     });
-    check_strips("bunny", &job, 0.01 * (hi - lo).length());
-    strip_build(&bunny, "2ft", "1%", &tmp.path().join("out"));
+    check_strips("bunny", &p, 0.01 * (hi - lo).length());
 }
 
 #[test]
@@ -607,20 +630,12 @@ fn simplified_models_with_holes_are_strips_within_the_bound() {
     }
 }
 
-/// Builds `model` at 4 ft within 0.5 % from the command line (every sheet checked; laid
-/// out by the shelf nester, since the strips are tested here, not how tightly they
-/// pack) and checks its strips through the library: more than one, within the bound
-/// both ways, the pieces the command line made.
+/// Builds `model` at 4 ft within 0.5 % once (every sheet checked; laid out by the shelf
+/// nester, since the strips are tested here, not how tightly they pack) and checks its
+/// strips: more than one, within the bound both ways, the pieces the manifest counts.
 fn strips_at_four_feet(what: &str, model: &Path, out: &Path) {
-    let m = strip_build_with(
-        model,
-        "4ft",
-        "0.5%",
-        &out.join("cli"),
-        &["--nester", "shelf"],
-    );
-    let job = strip_job(model, "4ft", "0.5%", &out.join("job"));
-    let (strips, pieces) = check_strips(what, &job, num(&m, "strip.max_deviation"));
+    let (p, m) = strip_built_once(model, "4ft", "0.5%", out, true);
+    let (strips, pieces) = check_strips(what, &p, num(&m, "strip.max_deviation"));
     assert!(strips > 1, "{what}: {strips} strips");
     assert_eq!(count(&m, "strip.pieces"), pieces, "{what}: the same pieces");
 }

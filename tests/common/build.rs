@@ -775,6 +775,41 @@ pub fn pipeline(job: &Job) -> Pipeline {
     }
 }
 
+/// The whole job through the library's stages, once: its files written to the job's
+/// output folder as the command line writes them (for the sheet checks), the manifest
+/// read back, and the scheme's results as [`pipeline`] gives them (for the facts the
+/// files do not hold). A test that needs both builds a large model once instead of
+/// twice. The command line's checks before the build (size, detail) are not run: as
+/// with `--build-anyway`.
+pub fn built_once(job: &Job) -> (Pipeline, Value) {
+    let loaded = unfold::run::load(job).expect("model loads");
+    let prepared = unfold::run::prepare(job, loaded).expect("scheme mesh");
+    let output = unfold::run::scheme(job, &prepared).expect("scheme");
+    let flat = unfold::run::flatten(job, &prepared, &output).expect("flattens");
+    let nested = unfold::run::nest(job, &flat, &|_| {}).expect("nests");
+    let exported =
+        unfold::run::export(job, &prepared, &output, &flat, &nested, Vec::new(), &|_| {})
+            .expect("exports");
+    std::fs::create_dir_all(&job.out).unwrap();
+    for (name, bytes) in &exported.files {
+        std::fs::write(job.out.join(name), bytes).unwrap();
+    }
+    let unfold::run::SchemeMesh { mesh, split, .. } = prepared.scheme_mesh;
+    let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
+    let flat = panels
+        .iter()
+        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
+        .collect();
+    let pipeline = Pipeline {
+        mesh,
+        split,
+        output,
+        panels,
+        flat,
+    };
+    (pipeline, read_manifest(&job.out))
+}
+
 /// The facet frames of each panel's unrolling (the flat panels' maps back to 3D).
 pub fn frames_of(panels: &[Panel]) -> Vec<Vec<FacetFrame>> {
     panels
