@@ -760,7 +760,12 @@ pub fn pipeline(job: &Job) -> Pipeline {
     let loaded = unfold::run::load(job).expect("model loads");
     let prepared = unfold::run::prepare(job, loaded).expect("scheme mesh");
     let output = unfold::run::scheme(job, &prepared).expect("scheme");
-    let unfold::run::SchemeMesh { mesh, split, .. } = prepared.scheme_mesh;
+    each_flattened(prepared.scheme_mesh, output)
+}
+
+/// The scheme's mesh and output with each panel flattened on its own.
+fn each_flattened(scheme_mesh: unfold::run::SchemeMesh, output: SchemeOutput) -> Pipeline {
+    let unfold::run::SchemeMesh { mesh, split, .. } = scheme_mesh;
     let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
     let flat = panels
         .iter()
@@ -794,20 +799,10 @@ pub fn built_once(job: &Job) -> (Pipeline, Value) {
     for (name, bytes) in &exported.files {
         std::fs::write(job.out.join(name), bytes).unwrap();
     }
-    let unfold::run::SchemeMesh { mesh, split, .. } = prepared.scheme_mesh;
-    let panels: Vec<Panel> = output.panels.iter().map(|p| p.to_panel()).collect();
-    let flat = panels
-        .iter()
-        .map(|p| flatten(p).unwrap_or_else(|e| panic!("{}: {e}", p.id())))
-        .collect();
-    let pipeline = Pipeline {
-        mesh,
-        split,
-        output,
-        panels,
-        flat,
-    };
-    (pipeline, read_manifest(&job.out))
+    (
+        each_flattened(prepared.scheme_mesh, output),
+        read_manifest(&job.out),
+    )
 }
 
 /// The facet frames of each panel's unrolling (the flat panels' maps back to 3D).
