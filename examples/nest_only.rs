@@ -78,7 +78,9 @@ fn main() -> anyhow::Result<()> {
     let efforts = or_job(&args.efforts, job.nest.search.effort);
     let seeds = or_job(&args.seeds, job.nest.search.seed);
     println!("parts {}", parts.outlines.len());
-    println!("effort\tseed\tsheets\teffective\tplaced\tmoved\tsqueezed\tbound\tnester\tseconds");
+    println!(
+        "effort\tseed\tsheets\teffective\tplaced\tmoved\tsqueezed\tbound\tnester\tseconds\tlayout"
+    );
     for &effort in &efforts {
         for &seed in &seeds {
             let mut settings: NestSettings = job.nest;
@@ -102,14 +104,35 @@ fn main() -> anyhow::Result<()> {
                 .map(|p| format!("{}\t{}\t{}", p.placed, p.moved, p.squeezed))
                 .unwrap_or_else(|| "-\t-\t-".to_string());
             println!(
-                "{effort}\t{seed}\t{}\t{effective:.2}\t{phases}\t{}\t{}\t{seconds:.1}",
+                "{effort}\t{seed}\t{}\t{effective:.2}\t{phases}\t{}\t{}\t{seconds:.1}\t{:016x}",
                 layout.sheets,
                 nested.spacing_bound,
-                nested.nester.as_str()
+                nested.nester.as_str(),
+                layout_hash(layout)
             );
         }
     }
     Ok(())
+}
+
+/// A fingerprint of every placement's bits (FNV-1a): two runs with the same one laid
+/// the parts out identically.
+fn layout_hash(layout: &unfold::nest::Layout) -> u64 {
+    let mut hash = 0xcbf2_9ce4_8422_2325_u64;
+    for p in &layout.placements {
+        let words = [
+            p.part as u64,
+            p.sheet as u64,
+            p.rotation.to_bits(),
+            p.translation.x.to_bits(),
+            p.translation.y.to_bits(),
+            u64::from(p.mirrored),
+        ];
+        for byte in words.iter().flat_map(|w| w.to_le_bytes()) {
+            hash = (hash ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    hash
 }
 
 /// `asked`, or the job's own value when none was asked.
