@@ -5,11 +5,12 @@
 //! overlapping grows (a guided local search), until nothing overlaps, or until the
 //! rounds, strikes or budget run out, when the squeeze puts the sheet back as it was.
 //!
-//! The separation's cost is in evaluating overlap: collecting every collision of a
-//! pose, where the constructive search stops at the first, and weighing the disc
-//! pairs. The effort budget counts each evaluation as [`OVERLAP_CHECK_COST`] checks
-//! plus one per [`DISC_PAIRS_PER_CHECK`] disc pairs: the cost of an evaluation relative
-//! to a constructive check, as measured on the bunny and the knight. On sheets holding
+//! The separation's cost is in evaluating overlap: collecting the collisions of a
+//! pose (until their weighted sum reaches the best pose's, where the constructive
+//! search stops at the first) and weighing the disc pairs. The effort budget counts
+//! each evaluation as [`OVERLAP_CHECK_COST`] checks plus one per
+//! [`DISC_PAIRS_PER_CHECK`] disc pairs: the cost of an evaluation relative to a
+//! constructive check, as measured on the bunny and the knight. On sheets holding
 //! hundreds of parts (horse_quad quad-edge) an evaluation costs about twice what it
 //! counts.
 
@@ -376,7 +377,7 @@ impl Nester<'_> {
     }
 
     /// Weighted overlap of `part` at `c` on sheet `s` (where it is not placed);
-    /// stops adding once `cap` is reached.
+    /// stops looking for collisions once the sum reaches `cap`.
     fn weighted_overlap(
         &mut self,
         s: usize,
@@ -393,34 +394,32 @@ impl Nester<'_> {
             self.scratch_part = part;
         }
         self.scratch.transform_from(shape, &transform);
-        let scratch = &mut self.overlap;
-        scratch.collector.clear();
-        self.sheets[s].layout.cde().collect_poly_collisions(
+        let super::part::OverlapScratch { collector, discs } = &mut self.overlap;
+        collector.clear();
+        // Each collision weighed as it is found, and the search stopped once the sum
+        // reaches the cap: the pose is then rejected whatever else it collides with.
+        let mut disc_pairs = 0;
+        let mut posed = false;
+        let mut total = 0.0;
+        let _stopped = self.sheets[s].layout.cde().collect_poly_collisions_until(
             &self.scratch,
             &NoFilter,
-            &mut scratch.collector,
+            collector,
+            |entity| {
+                total += match entity {
+                    BasicHazardEntity::PlacedItem { id, dt, .. } => {
+                        if !posed {
+                            discs.pose_mine(parts, part, &transform);
+                            posed = true;
+                        }
+                        let loss = discs.loss_with(parts, part, id, &dt, &mut disc_pairs);
+                        weights.get(part, id) * loss
+                    }
+                    _ => OUTSIDE,
+                };
+                total >= cap
+            },
         );
-        if scratch.collector.is_empty() {
-            self.count_evaluation(0);
-            return 0.0;
-        }
-        let mut disc_pairs = 0;
-        scratch.discs.pose_mine(parts, part, &transform);
-        let mut total = 0.0;
-        for (_, entity) in scratch.collector.iter() {
-            total += match entity {
-                BasicHazardEntity::PlacedItem { id, dt, .. } => {
-                    let loss = scratch
-                        .discs
-                        .loss_with(parts, part, *id, dt, &mut disc_pairs);
-                    weights.get(part, *id) * loss
-                }
-                _ => OUTSIDE,
-            };
-            if total >= cap {
-                break;
-            }
-        }
         self.count_evaluation(disc_pairs);
         total
     }
