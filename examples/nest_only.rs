@@ -2,16 +2,19 @@
 //! command line would (or reads them from a file written by an earlier run), then lays
 //! them out once per effort and seed asked, printing sheets, effective sheets (full
 //! sheets plus the last one's share of the sheet area, as `scripts/bench` prints them),
-//! the search's sheets after each phase and the time. For tuning the nester without
-//! building the panels each time:
+//! the search's sheets after each phase, the time and a fingerprint of the layout
+//! (equal fingerprints: the same placements, bit for bit). For tuning the nester
+//! without building the panels each time:
 //!
 //! ```text
 //! cargo run --release --example nest_only -- ../shared/models/decimated-knight.off \
 //!     --scheme net --size 4ft --sheet 18x24in --parts target/knight-net.json --efforts 5,10
 //! ```
 //!
-//! `--parts FILE` is read when it exists and written otherwise; the model and its
-//! options are then only used to build the parts the first time.
+//! `--parts FILE` is read when it exists and written otherwise. The file holds the
+//! parts' outlines and the sheet: once it exists, the options that shape the parts or
+//! the sheet are not used, and the nesting options (nester, rotations, mirror, effort,
+//! seed) still are.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;

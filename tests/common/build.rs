@@ -784,8 +784,8 @@ fn each_flattened(scheme_mesh: unfold::run::SchemeMesh, output: SchemeOutput) ->
 /// output folder as the command line writes them (for the sheet checks), the manifest
 /// read back, and the scheme's results as [`pipeline`] gives them (for the facts the
 /// files do not hold). A test that needs both builds a large model once instead of
-/// twice. The command line's checks before the build (size, detail) are not run: as
-/// with `--build-anyway`.
+/// twice. The command line's checks before the build (size, detail) are not run, as
+/// with `--build-anyway`, and the manifest lists no warnings.
 pub fn built_once(job: &Job) -> (Pipeline, Value) {
     let loaded = unfold::run::load(job).expect("model loads");
     let prepared = unfold::run::prepare(job, loaded).expect("scheme mesh");
